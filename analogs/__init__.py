@@ -1,0 +1,40 @@
+"""Mechanical analogs of liquid slosh declared as Lagrangian components.
+
+A component declares its coordinates, parameters (with units and bounds), the positions
+of its masses in the tank frame and its energy and dissipation terms; ``derive`` turns a
+model into equations of motion. Models compose with ``+``::
+
+    from analogs import LateralRig, FixedMass, Pendulum, HingeSpring, HingeDamper
+    model = LateralRig() + FixedMass("fixed") + Pendulum("p1") + HingeSpring("p1") + HingeDamper("p1")
+"""
+
+from .component import Attachment, Component, Rig
+from .fixed_mass import FixedMass
+from .hinge import DiaphragmSpring, HingeDamper, HingeSpring, QuadraticDamper
+from .model import Model, ModelError
+from .parameter import Param, Parameter
+from .pendulum import Pendulum, SphericalPendulum
+from .rigs import LateralRig, crank_displacement
+from .rotor import Rotor
+from .suspended_mass import SuspendedMass
+
+__all__ = [
+    "Attachment",
+    "Component",
+    "DiaphragmSpring",
+    "FixedMass",
+    "HingeDamper",
+    "HingeSpring",
+    "LateralRig",
+    "Model",
+    "ModelError",
+    "Param",
+    "Parameter",
+    "Pendulum",
+    "QuadraticDamper",
+    "Rig",
+    "Rotor",
+    "SphericalPendulum",
+    "SuspendedMass",
+    "crank_displacement",
+]

@@ -1,0 +1,149 @@
+"""Symbolic assembly: declared components -> Lagrangian -> M(q, p) qdd = f(q, qd, u, p, t).
+
+Only this module (and :mod:`analogs.declaration`) imports SymPy. The mass matrix is never
+inverted symbolically; outputs keep ``qdd`` as symbols, solved numerically in CasADi.
+"""
+
+from __future__ import annotations
+
+from dataclasses import dataclass
+
+import sympy as sp
+from sympy.physics import mechanics as me
+
+from analogs.component import Attachment, Rig
+from analogs.declaration import Declaration, FrameDeclaration, _Collected, _Shared
+from analogs.model import Model
+
+from .derived import OUTPUT_NAMES
+
+__all__ = ["SymbolicModel", "assemble", "OUTPUT_NAMES"]
+
+
+
+@dataclass(frozen=True)
+class SymbolicModel:
+    """Equations of a model with plain symbols in place of functions of time.
+
+    ``mass_matrix * qdd = forcing``; ``outputs`` may contain ``qdd``.
+    """
+
+    coordinates: tuple[str, ...]
+    q: tuple[sp.Symbol, ...]
+    qd: tuple[sp.Symbol, ...]
+    qdd: tuple[sp.Symbol, ...]
+    inputs: tuple[str, ...]
+    input_units: tuple[str, ...]
+    u: tuple[sp.Symbol, ...]
+    parameters: tuple[str, ...]
+    p: tuple[sp.Symbol, ...]
+    t: sp.Symbol
+    mass_matrix: sp.Matrix
+    forcing: sp.Matrix
+    outputs: tuple[sp.Expr, ...]
+    measured: tuple[str, ...]
+
+
+def assemble(model: Model) -> SymbolicModel:
+    """Derive the equations of motion and the rig outputs of ``model`` with SymPy."""
+    model.validate()
+    t = me.dynamicsymbols._t
+    N, T = me.ReferenceFrame("N"), me.ReferenceFrame("T")
+    shared = _Shared(N, T, me.Vector(0), me.Vector(0))
+    collected = _Collected()
+    psym = {p.name: sp.Symbol(p.name, real=True) for p in model.parameters}
+
+    def local_params(c):
+        return {p.local_name: psym[p.name] for p in c.bound_parameters()}
+
+    rig = model.rig
+    rig.declare_frame(FrameDeclaration(rig.name, local_params(rig), shared, collected))
+
+    coords: list[tuple[str, sp.Function]] = []
+    hosts: dict[str, Declaration] = {}
+    for c in model.components:
+        if isinstance(c, (Rig, Attachment)):
+            continue
+        qs = {name: me.dynamicsymbols(f"{c.prefix}.{name}") for name in c.coordinates}
+        coords += [(f"{c.prefix}.{name}", s) for name, s in qs.items()]
+        k = Declaration(c.name, qs, local_params(c), shared, collected)
+        c.declare(k)
+        hosts[c.name] = k
+    host_components = {c.name: c for c in model.components if not isinstance(c, (Rig, Attachment))}
+    for c in model.components:
+        if isinstance(c, Attachment):
+            hk = hosts[c.host]
+            k = Declaration(c.host, {}, local_params(c), shared, collected,
+                            host=hk, hinge=host_components[c.host].hinge_angles)
+            c.declare(k)
+
+    g = shared.gravity
+    r_O = shared.origin_position
+    kinetic = sp.S.Zero
+    potential = sp.Add(*collected.potential)
+    force = me.Vector(0)
+    torque = me.Vector(0)
+    for item in [*collected.particles, *collected.bodies]:
+        r_abs = r_O + item.position
+        v = r_abs.dt(N)
+        a = v.dt(N)
+        kinetic += item.mass * v.dot(v) / 2
+        potential += -item.mass * g.dot(r_abs)
+        f_i = item.mass * (a - g)
+        force += f_i
+        torque += item.position.cross(f_i)
+    for b in collected.bodies:
+        w = b.frame.ang_vel_in(N)
+        h = b.inertia.dot(w)
+        kinetic += w.dot(h) / 2
+        torque += h.dt(N)
+
+    qf = [s for _, s in coords]
+    n = len(qf)
+    if n:
+        lm = me.LagrangesMethod(kinetic - potential, qf)
+        lm.form_lagranges_equations()
+        M, f = lm.mass_matrix, lm.forcing
+        rayleigh = sp.Add(*collected.dissipation)
+        qdf = [s.diff(t) for s in qf]
+        extra = [-sp.diff(rayleigh, qd) for qd in qdf]
+        for coord, gen_force in collected.forces:
+            extra[qf.index(coord)] += gen_force
+        f = f + sp.Matrix(extra)
+    else:
+        M, f = sp.zeros(0, 0), sp.zeros(0, 1)
+
+    q = tuple(sp.Symbol(f"q{i}", real=True) for i in range(n))
+    qd = tuple(sp.Symbol(f"qd{i}", real=True) for i in range(n))
+    qdd = tuple(sp.Symbol(f"qdd{i}", real=True) for i in range(n))
+    inputs, units, usyms, rule = [], [], [], {}
+    for j, (sig, name, unit) in enumerate(shared.inputs):
+        for order, suffix, uunit in ((2, "_ddot", f"{unit}/s^2"), (1, "_dot", f"{unit}/s"), (0, "", unit)):
+            sym = sp.Symbol(f"u{j}_{order}", real=True)
+            rule[sig.diff(t, order) if order else sig] = sym
+        inputs += [name, f"{name}_dot", f"{name}_ddot"]
+        units += [unit, f"{unit}/s", f"{unit}/s^2"]
+        usyms += [rule[sig], rule[sig.diff(t)], rule[sig.diff(t, 2)]]
+    for i, s in enumerate(qf):
+        rule[s.diff(t, 2)] = qdd[i]
+        rule[s.diff(t)] = qd[i]
+        rule[s] = q[i]
+
+    def plain(e: sp.Expr) -> sp.Expr:
+        return e.xreplace(rule)
+
+    outputs = (
+        *[plain(c) for c in force.to_matrix(T)],
+        *[plain(c) for c in torque.to_matrix(T)],
+        plain(kinetic),
+        plain(potential),
+    )
+    names = tuple(p.name for p in model.parameters)
+    return SymbolicModel(
+        coordinates=tuple(name for name, _ in coords),
+        q=q, qd=qd, qdd=qdd,
+        inputs=tuple(inputs), input_units=tuple(units), u=tuple(usyms),
+        parameters=names, p=tuple(psym[nm] for nm in names), t=t,
+        mass_matrix=M.applyfunc(plain), forcing=f.applyfunc(plain),
+        outputs=outputs, measured=tuple(rig.measured),
+    )
