@@ -1,0 +1,23 @@
+"""Test configuration: single-threaded BLAS/OpenMP, a private derivation cache, and the
+independent reference models importable from ``tests/``."""
+
+import os
+import sys
+from pathlib import Path
+
+for _var in ("OMP_NUM_THREADS", "OPENBLAS_NUM_THREADS", "MKL_NUM_THREADS", "NUMEXPR_NUM_THREADS"):
+    os.environ.setdefault(_var, "1")
+
+_TESTS = Path(__file__).resolve().parent
+if str(_TESTS) not in sys.path:
+    sys.path.insert(0, str(_TESTS))
+
+import pytest  # noqa: E402
+
+
+@pytest.fixture(scope="session", autouse=True)
+def _private_cache(tmp_path_factory):
+    """Derived models are cached in a folder of this test session, not in the user's home."""
+    if "SLOSH_CACHE_DIR" not in os.environ or os.environ.get("SLOSH_TEST_KEEP_CACHE") != "1":
+        os.environ["SLOSH_CACHE_DIR"] = str(tmp_path_factory.mktemp("slosh-cache"))
+    yield
