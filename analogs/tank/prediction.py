@@ -1,0 +1,346 @@
+"""Tank + fill + liquid -> lateral slosh modes -> pendulum analog parameters.
+
+Analog quantities from each mode ``phi_n = U_n(r, z) cos(theta)`` (heights from the tank
+bottom, ``lambda_n = omega_n^2 / g``):
+
+* slosh (pendulum) mass ``m_n = rho pi lambda_n a_n^2 / b_n``, ``a_n = int r^2 U dr``,
+  ``b_n = int r U^2 dr`` over the free surface (matches the lateral force);
+* pendulum length ``L_n = g / omega_n^2 = 1 / lambda_n``;
+* bob height ``h_n = I_n / (lambda_n a_n)`` with ``I_n = int (z (U_r + U/r) - r U_z) r dr dz``
+  the mode's pitch angular-momentum integral (matches the pitch moment under lateral
+  excitation); hinge height ``h_n + L_n``. For a sphere the wall pressure passes through
+  the centre, and the hinge is exactly at the centre, which the solvers reproduce;
+* wave-height to bob-amplitude ratio ``lambda_n U_n(r_s) a_n / b_n``: the free-surface
+  elevation at the wall divided by the bob's lateral displacement in the same motion;
+* fixed mass ``m_0 = m_liquid - sum m_n`` (kept modes), at the height that preserves the
+  static centre of gravity;
+* fixed-mass pitch inertia: **inferred convention** -- the frozen liquid's moment of inertia
+  about a horizontal axis through the fixed mass, minus the bobs as point masses,
+  ``I_0 = I_rigid(h_0) - sum m_n (h_n - h_0)^2`` (so that the analog has the inertia of the
+  frozen liquid about its c.g.). This is not the potential-flow effective inertia (which is
+  near zero for a sphere); it is the definition that reproduces the SLOSH code's values in
+  the seed's Table 8 (0.007/0.010/0.014 kg m^2), inferred from them.
+"""
+
+from __future__ import annotations
+
+import json
+import math
+import time
+from dataclasses import asdict, dataclass, field
+from typing import Any, Union
+
+import numpy as np
+
+from . import _fem, _legacy, _ritz
+from ._modes import RawModes
+from .damping import cylinder_damping, sphere_damping
+from .geometry import WATER, Capsule, Cylinder, Liquid, Sphere, Tank
+
+__all__ = ["Exact", "FiniteElements", "FixedMassPrediction", "Legacy", "Ritz", "SloshMode",
+           "TankPrediction", "predict"]
+
+
+# -- solver strategies ---------------------------------------------------------------------
+@dataclass(frozen=True)
+class Ritz:
+    """Ritz with m = 1 solid harmonics up to ``degree`` (exponential convergence up to half
+    full spheres, algebraic above: use ``degree >= 80`` beyond 85 % fill)."""
+
+    degree: int = 60
+    rcond: float = 1e-12
+    name: str = "ritz"
+
+    def solve(self, tank: Tank, depth: float, n_modes: int) -> RawModes:
+        return _ritz.solve(tank, depth, degree=self.degree, n_modes=n_modes, rcond=self.rcond)
+
+
+@dataclass(frozen=True)
+class FiniteElements:
+    """Axisymmetric degree-``degree`` finite elements with ``layers`` geometric layers
+    (ratio ``ratio``) towards the contact line."""
+
+    degree: int = 7
+    layers: int = 7
+    ratio: float = 0.2
+    name: str = "fem"
+
+    def solve(self, tank: Tank, depth: float, n_modes: int) -> RawModes:
+        return _fem.solve(tank, depth, degree=self.degree, layers=self.layers,
+                          ratio=self.ratio, n_modes=n_modes)
+
+
+@dataclass(frozen=True)
+class Legacy:
+    """The SLOSH code's Lomen basis: ``n_poly`` polynomial + ``n_bessel`` Bessel-exponential
+    functions (spheres only)."""
+
+    n_poly: int = 5
+    n_bessel: int = 5
+    name: str = "legacy"
+
+    def solve(self, tank: Tank, depth: float, n_modes: int) -> RawModes:
+        return _legacy.solve(tank, depth, n_poly=self.n_poly, n_bessel=self.n_bessel,
+                             n_modes=n_modes)
+
+
+@dataclass(frozen=True)
+class Exact:
+    """Converged answer: Ritz where it converges fast (spheres up to 75 % depth, shallow
+    cylinders), graded finite elements elsewhere."""
+
+    name: str = "exact"
+
+    def choose(self, tank: Tank, depth: float) -> Ritz | FiniteElements:
+        if isinstance(tank, Sphere) and depth <= 1.5 * tank.radius:
+            return Ritz(degree=40 if depth <= tank.radius else 60)
+        if isinstance(tank, Cylinder) and depth <= 2.0 * tank.radius:
+            return Ritz(degree=40)
+        return FiniteElements()
+
+    def solve(self, tank: Tank, depth: float, n_modes: int) -> RawModes:
+        return self.choose(tank, depth).solve(tank, depth, n_modes)
+
+
+Solver = Union[Exact, Ritz, FiniteElements, Legacy]
+_METHODS = {"exact": Exact, "ritz": Ritz, "fem": FiniteElements, "legacy": Legacy}
+
+
+# -- results -------------------------------------------------------------------------------
+@dataclass(frozen=True)
+class SloshMode:
+    """One lateral slosh mode as a pendulum. SI units; heights from the tank bottom."""
+
+    index: int
+    frequency_hz: float  #: natural frequency, Hz
+    lam: float  #: eigenvalue omega^2 / g, 1/m
+    mass: float  #: pendulum (slosh) mass, kg
+    length: float  #: pendulum length, m
+    hinge_height: float  #: hinge height, m
+    bob_height: float  #: height of the bob (spring-mass location), m
+    amplitude_ratio: float  #: wave height at the wall / bob lateral amplitude, -
+    damping_ratio: float  #: viscous damping, fraction of critical (nan if no correlation)
+
+    @property
+    def omega(self) -> float:
+        """Natural frequency in rad/s."""
+        return 2.0 * math.pi * self.frequency_hz
+
+
+@dataclass(frozen=True)
+class FixedMassPrediction:
+    """The non-sloshing part of the liquid."""
+
+    mass: float  #: kg
+    height: float  #: m, from the tank bottom
+    inertia: float  #: pitch inertia about its own height, kg m^2 (inferred convention)
+
+
+@dataclass(frozen=True)
+class TankPrediction:
+    """Predicted analog parameters for a tank, fill and liquid (see :func:`predict`)."""
+
+    tank: Tank
+    liquid: Liquid
+    gravity: float
+    depth: float
+    fill_fraction: float
+    volume_fraction: float
+    liquid_mass: float
+    liquid_cg_height: float
+    method: str
+    solver: str
+    modes: tuple[SloshMode, ...]
+    fixed_mass: FixedMassPrediction
+    diaphragm: bool = False
+    size: int = 0
+    seconds: float = 0.0
+    notes: tuple[str, ...] = field(default=())
+
+    def to_dict(self) -> dict[str, Any]:
+        """The JSON document of ``slosh tank --json`` (fixed keys)."""
+        return {
+            "shape": self.tank.shape,
+            "radius": self.tank.radius,
+            "fill_fraction": self.fill_fraction,
+            "depth": self.depth,
+            "liquid_mass": self.liquid_mass,
+            "method": self.method,
+            "modes": [{"frequency_hz": m.frequency_hz, "lambda_R": m.lam * self.tank.radius,
+                       "mass": m.mass, "length": m.length, "hinge_height": m.hinge_height,
+                       "amplitude_ratio": m.amplitude_ratio, "damping_ratio": m.damping_ratio}
+                      for m in self.modes],
+            "fixed_mass": {"mass": self.fixed_mass.mass, "height": self.fixed_mass.height,
+                           "inertia": self.fixed_mass.inertia},
+        }
+
+    def to_json(self) -> str:
+        return json.dumps(self.to_dict(), indent=2)
+
+    def report(self) -> str:
+        """A readable table of the prediction."""
+        t = self.tank
+        lines = [
+            f"{t!r}, {self.liquid.name} (rho = {self.liquid.density:g} kg/m^3, "
+            f"nu = {self.liquid.viscosity:.4g} m^2/s), g = {self.gravity:g} m/s^2",
+            f"fill {100 * self.fill_fraction:.2f} % of height ({100 * self.volume_fraction:.2f} %"
+            f" of volume), depth {self.depth:.4f} m, liquid mass {self.liquid_mass:.4f} kg, "
+            f"c.g. {self.liquid_cg_height:.4f} m",
+            f"method {self.method} ({self.solver}, {self.size} unknowns, "
+            f"{1e3 * self.seconds:.1f} ms)",
+            "",
+            f"{'mode':>4} {'f [Hz]':>8} {'lambda R':>9} {'mass [kg]':>10} {'L [m]':>8} "
+            f"{'hinge [m]':>10} {'wave/bob':>9} {'zeta [%]':>9}",
+        ]
+        for m in self.modes:
+            lines.append(f"{m.index:>4} {m.frequency_hz:8.4f} {m.lam * t.radius:9.5f} "
+                         f"{m.mass:10.4f} {m.length:8.4f} {m.hinge_height:10.4f} "
+                         f"{m.amplitude_ratio:9.4f} {100 * m.damping_ratio:9.4f}")
+        f = self.fixed_mass
+        lines += ["", f"fixed mass {f.mass:.4f} kg at {f.height:.4f} m, pitch inertia "
+                      f"{f.inertia:.5f} kg m^2 (frozen-liquid convention)"]
+        lines += [f"note: {n}" for n in self.notes]
+        return "\n".join(lines)
+
+    def analog(self, *, bound_fraction: float = 0.2) -> Any:
+        """A ready analog model: rig + fixed mass + one damped pendulum per kept mode.
+
+        Predicted values are the defaults; the pendulum length is bounded to
+        ``(1 -+ bound_fraction)`` times its prediction. The hinge damper coefficient is
+        ``c = 2 zeta m L^2 omega`` (N m s/rad).
+
+        Examples
+        --------
+        >>> model = predict(Sphere(0.1016), fill=0.6).analog()  # doctest: +SKIP
+        """
+        from analogs import FixedMass, HingeDamper, LateralRig, Pendulum
+
+        f = self.fixed_mass
+        model = LateralRig() + FixedMass("fixed", mass=f.mass, height=f.height,
+                                         inertia=f.inertia)
+        for m in self.modes:
+            name = f"p{m.index}"
+            lo, hi = (1.0 - bound_fraction) * m.length, (1.0 + bound_fraction) * m.length
+            model = model + Pendulum(name, mass=m.mass, length=m.length,
+                                     hinge_height=m.hinge_height, bounds={"length": (lo, hi)})
+            if math.isfinite(m.damping_ratio):
+                c = 2.0 * m.damping_ratio * m.mass * m.length**2 * m.omega
+                model = model + HingeDamper(name, damping=c)
+        return model
+
+
+# -- the problem ---------------------------------------------------------------------------
+def _damping(tank: Tank, depth: float, liquid: Liquid, gravity: float) -> float:
+    nu = liquid.viscosity
+    if isinstance(tank, Sphere):
+        return sphere_damping(tank.radius, depth, nu, gravity)
+    if isinstance(tank, Cylinder):
+        return cylinder_damping(tank.radius, depth, nu, gravity)
+    if isinstance(tank, Capsule):
+        a, c = tank.radius, tank.cylinder_length
+        if depth <= a:  # bottom dome: a sphere of the same radius at this depth
+            return sphere_damping(a, depth, nu, gravity)
+        if depth >= a + c:  # top dome
+            return sphere_damping(a, depth - c, nu, gravity)
+        return cylinder_damping(a, depth, nu, gravity)
+    return float("nan")
+
+
+def _solver(method: str | Solver) -> Solver:
+    if isinstance(method, str):
+        try:
+            return _METHODS[method]()
+        except KeyError:
+            raise ValueError(f"`method` must be one of {sorted(_METHODS)} or a solver object "
+                             f"(`Ritz()`, `FiniteElements()`, `Legacy()`); got {method!r}."
+                             ) from None
+    if not hasattr(method, "solve"):
+        raise ValueError(f"`method` must be a name or a solver object; got {method!r}.")
+    return method
+
+
+def predict(tank: Tank, *, fill: float | None = None, volume_fill: float | None = None,
+            liquid: Liquid = WATER, gravity: float = 9.81, method: str | Solver = "exact",
+            modes: int = 2, diaphragm: bool = False) -> TankPrediction:
+    """Predict the pendulum analog of lateral slosh for a tank, fill and liquid.
+
+    Parameters
+    ----------
+    tank : Tank
+        :class:`Sphere`, :class:`Cylinder`, :class:`Capsule` or :class:`Profile`.
+    fill, volume_fill : float
+        Liquid depth / tank height, or liquid volume / tank volume, in (0, 1); give one.
+    liquid : Liquid
+        Density (kg/m^3) and kinematic viscosity (m^2/s); default water at 20 C.
+    gravity : float
+        Axial acceleration in m/s^2 (default 9.81).
+    method : str or solver
+        ``"exact"`` (default), ``"legacy"``, ``"ritz"``, ``"fem"`` or a solver object
+        (:class:`Exact`, :class:`Ritz`, :class:`FiniteElements`, :class:`Legacy`).
+    modes : int
+        Number of modes kept as pendulums (default 2).
+    diaphragm : bool
+        The tank has a diaphragm: the prediction stays the free-surface one and a note
+        says what the diaphragm changes.
+
+    Returns
+    -------
+    TankPrediction
+
+    Examples
+    --------
+    >>> p = predict(Sphere(0.1016), fill=0.5)
+    >>> round(p.modes[0].lam * 0.1016, 4)
+    1.5602
+    """
+    if not isinstance(tank, Tank):
+        raise ValueError("`tank` must be a Sphere, Cylinder, Capsule or Profile; got "
+                         f"{tank!r}.")
+    gravity_ = float(gravity) if isinstance(gravity, (int, float)) else float("nan")
+    if not (math.isfinite(gravity_) and gravity_ > 0):
+        raise ValueError(f"`gravity` must be a positive acceleration in m/s^2; got {gravity!r}.")
+    if not (isinstance(modes, int) and 1 <= modes <= 6):
+        raise ValueError(f"`modes` must be an integer from 1 to 6; got {modes!r}.")
+    if not isinstance(liquid, Liquid):
+        raise ValueError(f"`liquid` must be a Liquid(density=..., viscosity=...); got {liquid!r}.")
+    solver = _solver(method)
+    depth = tank.depth_from_fill(fill, volume_fill=volume_fill)
+
+    t0 = time.perf_counter()
+    raw = solver.solve(tank, depth, modes)
+    seconds = time.perf_counter() - t0
+    used = solver.choose(tank, depth).name if isinstance(solver, Exact) else solver.name
+
+    rho, g = liquid.density, gravity_
+    volume = tank.volume(depth)
+    m_liq = rho * volume
+    z_cg = tank.centroid_height(depth)
+    zeta = _damping(tank, depth, liquid, g)
+    out = []
+    for n in range(modes):
+        lam, a, b = raw.lam[n], raw.a[n], raw.b[n]
+        bob = raw.moment[n] / (lam * a)
+        out.append(SloshMode(
+            index=n + 1, frequency_hz=math.sqrt(lam * g) / (2.0 * math.pi), lam=float(lam),
+            mass=float(rho * math.pi * lam * a * a / b), length=float(1.0 / lam),
+            hinge_height=float(bob + 1.0 / lam), bob_height=float(bob),
+            amplitude_ratio=float(lam * raw.u_wall[n] * a / b), damping_ratio=zeta))
+    m0 = m_liq - sum(m.mass for m in out)
+    h0 = (m_liq * z_cg - sum(m.mass * m.bob_height for m in out)) / m0
+    inertia = rho * tank.rigid_inertia(depth, h0) - sum(m.mass * (m.bob_height - h0) ** 2
+                                                       for m in out)
+    notes = []
+    if diaphragm:
+        notes.append("diaphragm: this is the free-surface prediction; a diaphragm raises the "
+                     "frequency, lowers the slosh mass and adds damping - estimate them from data")
+    if not math.isfinite(zeta):
+        notes.append("no damping correlation for a general profile: damping_ratio is nan")
+    if isinstance(solver, Legacy):
+        notes.append("legacy Lomen basis (SLOSH code conventions): not converged above half full")
+    return TankPrediction(
+        tank=tank, liquid=liquid, gravity=g, depth=float(depth),
+        fill_fraction=float(depth / tank.height), volume_fraction=float(volume / tank.volume()),
+        liquid_mass=float(m_liq), liquid_cg_height=float(z_cg), method=solver.name,
+        solver=used, modes=tuple(out),
+        fixed_mass=FixedMassPrediction(mass=float(m0), height=float(h0), inertia=float(inertia)),
+        diaphragm=bool(diaphragm), size=raw.size, seconds=seconds, notes=tuple(notes))
