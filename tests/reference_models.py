@@ -1,0 +1,470 @@
+"""Independent reference simulator of a lateral slosh rig, for tests and example data.
+
+Plain numpy + ``scipy.integrate.solve_ivp`` with HAND-WRITTEN equations; it deliberately does
+not import ``analogs``, ``derive`` or ``estimate``, so it can check them.
+
+Model
+-----
+The tank translates by a prescribed ``x(t)`` along the rig axis. Each planar pendulum ``i``
+(bob mass ``m``, length ``L``, hinge spring ``k`` [N m/rad], linear hinge damper ``c``
+[N m s/rad], quadratic hinge damper ``c2`` [N m s^2/rad^2], torque ``c2 thd |thd|``) obeys::
+
+    m L^2 thdd + m L xdd cos(th) + m g L sin(th) + k th + c thd + c2 thd |thd| = 0
+
+and the force the transducer measures is::
+
+    F = (m_dry + m_fixed) xdd + sum_i m_i (xdd + L_i thdd_i cos(th_i) - L_i thd_i^2 sin(th_i))
+
+Measurement effects (all optional):
+
+* sensor delay ``tau``: the recorded force at ``t`` is the force at ``t - tau``. The pendulums
+  start from their initial state at ``t[0] - tau`` and ``solve_ivp`` reports the state exactly
+  at both ``t`` and ``t - tau`` (``t_eval``), so no interpolation is involved.
+* rig friction seen by the transducer: ``F_c sign(xd) + c_v xd`` (the transducer pushes the
+  carriage, so it also pushes against the friction).
+* a motor tone ``a sin(2 pi f t + phase)`` added to the force.
+* white Gaussian force noise of standard deviation ``noise * RMS(F_mech)``, with ``F_mech`` the
+  delayed mechanical force plus friction (the tone is not counted), and optional white
+  displacement noise [m].
+
+Excitations are objects returning ``(x, xd, xdd)`` at any times, with analytic derivatives:
+:class:`Sine`, :class:`Crank` (the seed's "locomotive arm"), :class:`LinearSweep`,
+:class:`SteppedSweep` and :class:`AmplitudeSteps` (the last two with smooth C2 transitions so the
+acceleration stays finite and continuous).
+
+Example
+-------
+>>> import numpy as np
+>>> from reference_models import Pendulum, Sine, simulate_lateral
+>>> t = np.arange(3001) * 0.01
+>>> out = simulate_lateral(t, Sine(0.005, 1.855), pendulums=[Pendulum(1.338, 0.057)],
+...                        fixed_mass=1.456, dry_mass=1.2)
+>>> out["force"].shape
+(3001,)
+"""
+
+from __future__ import annotations
+
+import os
+
+os.environ.setdefault("OMP_NUM_THREADS", "1")
+os.environ.setdefault("OPENBLAS_NUM_THREADS", "1")
+os.environ.setdefault("MKL_NUM_THREADS", "1")
+
+from collections.abc import Sequence  # noqa: E402
+from dataclasses import dataclass  # noqa: E402
+from typing import Protocol  # noqa: E402
+
+import numpy as np  # noqa: E402
+from numpy.typing import ArrayLike, NDArray  # noqa: E402
+from scipy.integrate import solve_ivp  # noqa: E402
+
+__all__ = [
+    "AmplitudeSteps",
+    "Crank",
+    "Excitation",
+    "Friction",
+    "LinearSweep",
+    "Pendulum",
+    "Sine",
+    "SteppedSweep",
+    "Tone",
+    "hinge_damping",
+    "natural_frequency",
+    "simulate_lateral",
+]
+
+Array = NDArray[np.float64]
+STANDARD_GRAVITY = 9.80665
+
+
+# ----------------------------------------------------------------------------------------------
+# components and measurement effects
+
+
+@dataclass(frozen=True)
+class Pendulum:
+    """Planar pendulum on the tank.
+
+    Attributes
+    ----------
+    mass : float
+        Bob mass m [kg].
+    length : float
+        Length L [m].
+    stiffness : float
+        Hinge spring k [N m/rad].
+    damping : float
+        Linear hinge damper c [N m s/rad].
+    quadratic_damping : float
+        Quadratic hinge damper c2 [N m s^2/rad^2] (torque ``c2 thd |thd|``).
+    """
+
+    mass: float
+    length: float
+    stiffness: float = 0.0
+    damping: float = 0.0
+    quadratic_damping: float = 0.0
+
+
+def natural_frequency(p: Pendulum, gravity: float = STANDARD_GRAVITY) -> float:
+    """Small-amplitude undamped natural frequency ``sqrt(g/L + k/(m L^2))`` [rad/s]."""
+    return float(np.sqrt(gravity / p.length + p.stiffness / (p.mass * p.length**2)))
+
+
+def hinge_damping(mass: float, length: float, damping_ratio: float, *, stiffness: float = 0.0,
+                  gravity: float = STANDARD_GRAVITY) -> float:
+    """Hinge damper ``c = 2 zeta m L^2 omega`` [N m s/rad] for a damping ratio ``zeta``."""
+    omega = np.sqrt(gravity / length + stiffness / (mass * length**2))
+    return float(2.0 * damping_ratio * mass * length**2 * omega)
+
+
+@dataclass(frozen=True)
+class Tone:
+    """Motor tone added to the measured force: ``amplitude sin(2 pi frequency t + phase)``.
+
+    Attributes
+    ----------
+    amplitude : float
+        [N].
+    frequency : float
+        [Hz].
+    phase : float
+        [rad].
+    """
+
+    amplitude: float
+    frequency: float
+    phase: float = 0.0
+
+
+@dataclass(frozen=True)
+class Friction:
+    """Rig friction seen by the transducer: ``coulomb sign(xd) + viscous xd``.
+
+    Attributes
+    ----------
+    coulomb : float
+        Coulomb force level [N].
+    viscous : float
+        Viscous coefficient [N s/m].
+    """
+
+    coulomb: float = 0.0
+    viscous: float = 0.0
+
+
+# ----------------------------------------------------------------------------------------------
+# excitations
+
+
+class Excitation(Protocol):
+    """Prescribed carriage motion: ``motion(t) -> (x [m], xd [m/s], xdd [m/s^2])``."""
+
+    def __call__(self, t: ArrayLike) -> tuple[Array, Array, Array]: ...
+
+
+def _harmonic(a: Array, da: Array, dda: Array, ph: Array, dph: Array, ddph: Array
+              ) -> tuple[Array, Array, Array]:
+    """x = A(t) sin(phi(t)) and its first two derivatives (product and chain rules)."""
+    s, c = np.sin(ph), np.cos(ph)
+    x = a * s
+    xd = da * s + a * dph * c
+    xdd = dda * s + 2.0 * da * dph * c + a * ddph * c - a * dph**2 * s
+    return x, xd, xdd
+
+
+def _smoothstep_levels(t: Array, levels: Sequence[float], dwell: float, ramp: float
+                       ) -> tuple[Array, Array, Array, Array]:
+    """Piecewise-constant levels joined by quintic smoothsteps (C2).
+
+    Level k holds from ``k dwell + ramp`` to ``(k + 1) dwell``; the change from level k-1 to k
+    takes ``[k dwell, k dwell + ramp]``. Returns (value, d/dt, d2/dt2, integral from 0 to t).
+    """
+    v0 = float(levels[0])
+    val = np.full_like(t, v0)
+    d1 = np.zeros_like(t)
+    d2 = np.zeros_like(t)
+    integral = v0 * t
+    for k in range(1, len(levels)):
+        jump = float(levels[k]) - float(levels[k - 1])
+        u = (t - k * dwell) / ramp
+        uc = np.clip(u, 0.0, 1.0)
+        inside = (u > 0.0) & (u < 1.0)
+        val = val + jump * (10 * uc**3 - 15 * uc**4 + 6 * uc**5)
+        d1 = d1 + np.where(inside, jump * (30 * uc**2 - 60 * uc**3 + 30 * uc**4) / ramp, 0.0)
+        d2 = d2 + np.where(inside, jump * (60 * uc - 180 * uc**2 + 120 * uc**3) / ramp**2, 0.0)
+        # integral of the smoothstep: 2.5 u^4 - 3 u^5 + u^6 on [0, 1] (0.5 at u = 1), then linear
+        integ = np.where(u <= 0.0, 0.0,
+                         np.where(u < 1.0, 2.5 * uc**4 - 3 * uc**5 + uc**6, 0.5 + (u - 1.0)))
+        integral = integral + jump * ramp * integ
+    return val, d1, d2, integral
+
+
+@dataclass(frozen=True)
+class Sine:
+    """``x = amplitude sin(2 pi frequency t + phase)``; amplitude [m], frequency [Hz]."""
+
+    amplitude: float
+    frequency: float
+    phase: float = 0.0
+
+    def __call__(self, t: ArrayLike) -> tuple[Array, Array, Array]:
+        tt = np.asarray(t, dtype=float)
+        w = 2.0 * np.pi * self.frequency
+        one = np.ones_like(tt)
+        zero = np.zeros_like(tt)
+        return _harmonic(self.amplitude * one, zero, zero, w * tt + self.phase, w * one, zero)
+
+
+@dataclass(frozen=True)
+class Crank:
+    """The seed's crank ("locomotive arm") drive.
+
+    Flywheel angle ``phi = phi0 + (2 pi frequency + d_omega) t``; carriage displacement
+    ``x = r cos(phi) + sqrt(l^2 - r^2 sin(phi)^2) - l``.
+
+    Attributes
+    ----------
+    radius : float
+        Crank radius r [m].
+    rod_length : float
+        Connecting-rod length l [m] (> r).
+    frequency : float
+        Nominal drive frequency [Hz].
+    d_omega : float
+        Angular-velocity correction dOmega [rad/s].
+    phi0 : float
+        Initial flywheel angle [rad].
+    """
+
+    radius: float
+    rod_length: float
+    frequency: float
+    d_omega: float = 0.0
+    phi0: float = 0.0
+
+    @property
+    def omega(self) -> float:
+        """Actual flywheel rate ``2 pi frequency + d_omega`` [rad/s]."""
+        return 2.0 * np.pi * self.frequency + self.d_omega
+
+    def __call__(self, t: ArrayLike) -> tuple[Array, Array, Array]:
+        tt = np.asarray(t, dtype=float)
+        r, l, om = self.radius, self.rod_length, self.omega
+        phi = self.phi0 + om * tt
+        sp, cp = np.sin(phi), np.cos(phi)
+        s = np.sqrt(l**2 - r**2 * sp**2)
+        g = r**2 * sp * cp                 # -(1/2) d(s^2)/dphi, so ds/dphi = -g / s
+        dg = r**2 * (cp**2 - sp**2)
+        x = r * cp + s - l
+        xd = om * (-r * sp - g / s)
+        xdd = om**2 * (-r * cp - dg / s - g**2 / s**3)
+        return x, xd, xdd
+
+
+@dataclass(frozen=True)
+class LinearSweep:
+    """Linear chirp from ``f_start`` to ``f_end`` [Hz] over ``duration`` [s], amplitude [m].
+
+    The frequency is held at ``f_start`` before 0 and at ``f_end`` after ``duration`` (the
+    acceleration has a finite jump in slope there).
+    """
+
+    amplitude: float
+    f_start: float
+    f_end: float
+    duration: float
+    phase: float = 0.0
+
+    def __call__(self, t: ArrayLike) -> tuple[Array, Array, Array]:
+        tt = np.asarray(t, dtype=float)
+        rate = (self.f_end - self.f_start) / self.duration
+        tc = np.clip(tt, 0.0, self.duration)
+        cycles = self.f_start * tc + 0.5 * rate * tc**2
+        cycles = cycles + np.where(tt < 0.0, self.f_start * tt, 0.0)
+        cycles = cycles + np.where(tt > self.duration, self.f_end * (tt - self.duration), 0.0)
+        freq = self.f_start + rate * tc
+        dfreq = np.where((tt >= 0.0) & (tt <= self.duration), rate, 0.0)
+        one = np.ones_like(tt)
+        zero = np.zeros_like(tt)
+        return _harmonic(self.amplitude * one, zero, zero, 2 * np.pi * cycles + self.phase,
+                         2 * np.pi * freq, 2 * np.pi * dfreq)
+
+
+@dataclass(frozen=True)
+class SteppedSweep:
+    """Stepped-frequency sine: ``frequencies`` [Hz] each held ``dwell`` [s], amplitude [m].
+
+    Frequency changes take ``ramp`` seconds (quintic smoothstep), phase continuous.
+    """
+
+    amplitude: float
+    frequencies: tuple[float, ...]
+    dwell: float
+    ramp: float = 0.5
+    phase: float = 0.0
+
+    def __call__(self, t: ArrayLike) -> tuple[Array, Array, Array]:
+        tt = np.asarray(t, dtype=float)
+        f, df, ddf, cycles = _smoothstep_levels(tt, self.frequencies, self.dwell, self.ramp)
+        one = np.ones_like(tt)
+        zero = np.zeros_like(tt)
+        return _harmonic(self.amplitude * one, zero, zero, 2 * np.pi * cycles + self.phase,
+                         2 * np.pi * f, 2 * np.pi * df)
+
+
+@dataclass(frozen=True)
+class AmplitudeSteps:
+    """Sine at ``frequency`` [Hz] with amplitude ``amplitudes`` [m] each held ``dwell`` [s].
+
+    Amplitude changes take ``ramp`` seconds (quintic smoothstep).
+    """
+
+    amplitudes: tuple[float, ...]
+    frequency: float
+    dwell: float
+    ramp: float = 0.5
+    phase: float = 0.0
+
+    def __call__(self, t: ArrayLike) -> tuple[Array, Array, Array]:
+        tt = np.asarray(t, dtype=float)
+        a, da, dda, _ = _smoothstep_levels(tt, self.amplitudes, self.dwell, self.ramp)
+        w = 2.0 * np.pi * self.frequency
+        return _harmonic(a, da, dda, w * tt + self.phase, w * np.ones_like(tt), np.zeros_like(tt))
+
+
+# ----------------------------------------------------------------------------------------------
+# simulation
+
+
+def _pendulum_accel(th: Array, thd: Array, xdd: Array, p: Pendulum, g: float) -> Array:
+    """thdd from m L^2 thdd + m L xdd cos th + m g L sin th + k th + c thd + c2 thd|thd| = 0."""
+    m, L = p.mass, p.length
+    torque = (m * L * xdd * np.cos(th) + m * g * L * np.sin(th) + p.stiffness * th
+              + p.damping * thd + p.quadratic_damping * thd * np.abs(thd))
+    return -torque / (m * L**2)
+
+
+def simulate_lateral(
+    t: ArrayLike,
+    excitation: Excitation,
+    *,
+    pendulums: Sequence[Pendulum] = (),
+    fixed_mass: float = 0.0,
+    dry_mass: float = 0.0,
+    gravity: float = STANDARD_GRAVITY,
+    initial_theta: Sequence[float] | None = None,
+    initial_theta_dot: Sequence[float] | None = None,
+    sensor_delay: float = 0.0,
+    noise: float = 0.0,
+    displacement_noise: float = 0.0,
+    tone: Tone | None = None,
+    friction: Friction | None = None,
+    seed: int | None = None,
+    rtol: float = 1e-10,
+    atol: float = 1e-12,
+) -> dict[str, NDArray[np.float64] | float | str]:
+    """Simulate a lateral slosh rig with hand-written equations (DOP853).
+
+    Parameters
+    ----------
+    t : array_like
+        Increasing output times [s].
+    excitation : Excitation
+        Carriage motion, ``excitation(t) -> (x, xd, xdd)``.
+    pendulums : sequence of Pendulum
+        Planar pendulums (any number, may be empty).
+    fixed_mass, dry_mass : float
+        Fixed liquid mass and rig dry mass [kg], both moving rigidly with the tank.
+    gravity : float, default 9.80665
+        [m/s^2].
+    initial_theta, initial_theta_dot : sequence of float, optional
+        Pendulum angles [rad] and rates [rad/s] at ``t[0] - sensor_delay``; default at rest.
+    sensor_delay : float, default 0
+        Force sensor delay tau [s] >= 0: ``force[i]`` is the force at ``t[i] - tau``.
+    noise : float, default 0
+        Force noise standard deviation as a fraction of the RMS mechanical force [-].
+    displacement_noise : float, default 0
+        Displacement noise standard deviation [m].
+    tone : Tone, optional
+        Motor tone added to the force.
+    friction : Friction, optional
+        Rig friction seen by the transducer.
+    seed : int, optional
+        Seed of ``numpy.random.default_rng`` for the noise.
+    rtol, atol : float
+        ``solve_ivp`` tolerances (angles in rad).
+
+    Returns
+    -------
+    dict
+        ``time`` [s]; ``displacement`` (with noise), ``displacement_clean`` [m]; ``velocity``
+        [m/s]; ``acceleration`` [m/s^2]; ``force`` (everything), ``force_clean`` (delay,
+        friction and tone, no noise), ``force_true`` (mechanical force at ``t``, no effects)
+        [N]; ``theta``, ``theta_dot``, ``theta_ddot`` with shape (n_pendulums, n) at ``t``;
+        ``nfev``; ``message``.
+    """
+    tt = np.asarray(t, dtype=float)
+    if tt.ndim != 1 or tt.size < 2 or np.any(np.diff(tt) <= 0):
+        raise ValueError("expected a 1-D increasing array `t` with at least 2 samples")
+    if sensor_delay < 0:
+        raise ValueError(f"expected `sensor_delay` >= 0 s, found {sensor_delay!r}")
+    pend = list(pendulums)
+    n_p = len(pend)
+    th0 = np.zeros(n_p) if initial_theta is None else np.asarray(initial_theta, dtype=float)
+    thd0 = np.zeros(n_p) if initial_theta_dot is None else np.asarray(initial_theta_dot, dtype=float)
+    if th0.shape != (n_p,) or thd0.shape != (n_p,):
+        raise ValueError(f"expected {n_p} initial angles and rates, found {th0.shape}, {thd0.shape}")
+
+    t_delayed = tt - sensor_delay
+    t_all = np.unique(np.concatenate([tt, t_delayed]))
+    t0 = t_all[0]
+
+    def rhs(time: float, y: Array) -> Array:
+        _, _, xdd = excitation(np.array([time]))
+        th, thd = y[:n_p], y[n_p:]
+        thdd = np.array([_pendulum_accel(th[i], thd[i], xdd[0], pend[i], gravity)
+                         for i in range(n_p)])
+        return np.concatenate([thd, thdd])
+
+    nfev, message = 0, "no pendulums: nothing to integrate"
+    if n_p:
+        sol = solve_ivp(rhs, (t0, t_all[-1]), np.concatenate([th0, thd0]), method="DOP853",
+                        t_eval=t_all, rtol=rtol, atol=atol)
+        if not sol.success:
+            raise RuntimeError(f"solve_ivp failed: {sol.message}")
+        states = sol.y
+        nfev, message = int(sol.nfev), str(sol.message)
+    else:
+        states = np.zeros((0, t_all.size))
+
+    def at(times: Array) -> tuple[Array, Array, Array, Array, Array, Array, Array]:
+        idx = np.searchsorted(t_all, times)
+        th, thd = states[:n_p, idx], states[n_p:, idx]
+        x, xd, xdd = excitation(times)
+        thdd = np.array([_pendulum_accel(th[i], thd[i], xdd, pend[i], gravity)
+                         for i in range(n_p)]).reshape(n_p, times.size)
+        force = (dry_mass + fixed_mass) * xdd
+        for i, p in enumerate(pend):
+            force = force + p.mass * (xdd + p.length * thdd[i] * np.cos(th[i])
+                                      - p.length * thd[i] ** 2 * np.sin(th[i]))
+        return x, xd, xdd, th, thd, thdd, force
+
+    x, xd, xdd, th, thd, thdd, force_true = at(tt)
+    _, xd_del, _, _, _, _, force_del = at(t_delayed)
+    mech = force_del.copy()
+    if friction is not None:
+        mech = mech + friction.coulomb * np.sign(xd_del) + friction.viscous * xd_del
+    clean = mech.copy()
+    if tone is not None:
+        clean = clean + tone.amplitude * np.sin(2 * np.pi * tone.frequency * tt + tone.phase)
+    rng = np.random.default_rng(seed)
+    force = clean + rng.normal(0.0, noise * float(np.sqrt(np.mean(mech**2))), tt.size)
+    disp = x + rng.normal(0.0, displacement_noise, tt.size) if displacement_noise else x.copy()
+    return {
+        "time": tt.copy(), "displacement": disp, "displacement_clean": x, "velocity": xd,
+        "acceleration": xdd, "force": force, "force_clean": clean, "force_true": force_true,
+        "theta": th, "theta_dot": thd, "theta_ddot": thdd, "nfev": float(nfev),
+        "message": message,
+    }
