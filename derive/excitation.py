@@ -21,13 +21,16 @@ class Excitation:
 
     #: Number of input values supplied (3 per signal: value and two derivatives).
     size: int = 3
+    #: True when :meth:`symbolic` accepts SX as well as MX (closed-form in time), so the
+    #: excitation can be evaluated inside generated code instead of passed as data.
+    analytic: bool = False
 
     def values(self, t: np.ndarray) -> np.ndarray:
         """Input values at times ``t`` (s), shape ``(size, len(t))``."""
         raise NotImplementedError
 
     def symbolic(self, t: ca.MX) -> ca.MX:
-        """Input values as a CasADi expression of time."""
+        """Input values as a CasADi expression of time (a column of :attr:`size`)."""
         raise NotImplementedError
 
 
@@ -36,12 +39,13 @@ class NoExcitation(Excitation):
     """A tank at rest (all signals zero), or a rig whose motion needs no input."""
 
     size: int = 3
+    analytic: bool = True
 
     def values(self, t: np.ndarray) -> np.ndarray:
         return np.zeros((self.size, np.size(t)))
 
-    def symbolic(self, t: ca.MX) -> ca.MX:
-        return ca.MX.zeros(self.size, 1)
+    def symbolic(self, t):
+        return ca.DM.zeros(self.size, 1) * t if self.size else type(t)(0, 1)
 
 
 @dataclass(frozen=True)
@@ -52,6 +56,7 @@ class Sine(Excitation):
     amplitude: float
     frequency: float
     phase: float = 0.0
+    analytic: bool = field(default=True, init=False, repr=False)
 
     def _parts(self, t, lib):
         w = 2 * math.pi * self.frequency

@@ -22,9 +22,12 @@ class RK4:
 
     Code-generatable (used for C export and multiple shooting). The inputs are sampled
     at the stage times, so the result matches an exact integration to O(h^4).
+    ``compiled=True`` generates C for the whole run and compiles it once (cached on disk,
+    see :mod:`derive.cache`); it needs a C compiler and pays off for repeated runs.
     """
 
     substeps: int = 1
+    compiled: bool = False
 
     def __post_init__(self) -> None:
         if int(self.substeps) != self.substeps or self.substeps < 1:
@@ -100,18 +103,54 @@ def rk4_step(dm: DerivedModel, substeps: int = 1) -> ca.Function:
     return dm._memo[key]
 
 
-def _horizon(dm: DerivedModel, substeps: int, n: int) -> ca.Function:
-    key = ("rk4_horizon", substeps, n)
-    if key not in dm._memo:
-        dm._memo[key] = rk4_step(dm, substeps).mapaccum("rk4_horizon", n)
-    return dm._memo[key]
+def _simulator(dm: DerivedModel, exc: Excitation, substeps: int, n: int,
+               outputs: tuple[int, ...], compile_: bool) -> ca.Function:
+    """One CasADi function for a whole fixed-step run.
 
+    ``sim(x0, U, p, t, h, Ug) -> (X, Y)``: ``U`` the inputs at the RK4 stage times and ``Ug``
+    at the grid (both empty when the excitation is analytic and evaluated inside), ``t``
+    and ``h`` the interval start times and lengths, ``X`` the states on the grid and ``Y``
+    the selected outputs.
+    """
+    key = ("sim", exc if exc.analytic else None, substeps, n, outputs, compile_)
+    if key in dm._memo:
+        return dm._memo[key]
+    m = 2 * substeps + 1
+    x = ca.SX.sym("x", dm.nx)
+    p = ca.SX.sym("p", len(dm.parameter_names))
+    t = ca.SX.sym("t")
+    h = ca.SX.sym("h")
+    if exc.analytic:
+        Uk = ca.SX(0, 1)
+        U = ca.horzcat(*[exc.symbolic(t + h * j / (m - 1)) for j in range(m)])
+        ug = ca.SX(0, 1)
+        u_grid = exc.symbolic(t)
+    else:
+        Uk = ca.SX.sym("U", dm.nu * m)
+        U = ca.reshape(Uk, dm.nu, m)
+        ug = ca.SX.sym("ug", dm.nu)
+        u_grid = ug
+    step = ca.Function("step", [x, Uk, p, t, h], [rk4_step(dm, substeps)(x, U, p, t, h)])
+    y = dm.outputs(x, u_grid, p, t)
+    out = ca.Function("out", [x, ug, p, t], [ca.vertcat(*[y[i] for i in outputs])])
+    horizon = step.mapaccum("horizon", n)
+    out_map = out.map(n + 1)
+    X0 = ca.MX.sym("x0", dm.nx)
+    UU = ca.MX.sym("U", Uk.numel(), n)
+    P = ca.MX.sym("p", p.numel())
+    T = ca.MX.sym("t", 1, n + 1)
+    H = ca.MX.sym("h", 1, n)
+    UG = ca.MX.sym("Ug", ug.numel(), n + 1)
+    X = ca.horzcat(X0, horizon(X0, UU, P, T[:, :n], H))
+    Y = out_map(X, UG, P, T)
+    fn = ca.Function("simulate_rk4", [X0, UU, P, T, H, UG], [X, Y],
+                     ["x0", "U", "p", "t", "h", "Ug"], ["X", "Y"])
+    if compile_:
+        from ._compile import compiled
 
-def _output_map(dm: DerivedModel, n: int) -> ca.Function:
-    key = ("outputs", n)
-    if key not in dm._memo:
-        dm._memo[key] = dm.outputs.map(n)
-    return dm._memo[key]
+        fn = compiled(fn)
+    dm._memo[key] = fn
+    return fn
 
 
 def _initial_state(dm: DerivedModel, x0) -> np.ndarray:
@@ -156,9 +195,9 @@ def simulate(
     x0 : mapping or array, optional
         Initial state (default: at rest, all zero).
     outputs : tuple of str, optional
-        Output channels whose parameters must be given (default: the rig's measured
-        channels). All outputs are computed; others may be NaN when their parameters
-        have no value.
+        Output channels to compute; their parameters must have values. Default: all
+        outputs, with values required only for the rig's measured channels (outputs whose
+        parameters are missing come out NaN).
 
     Examples
     --------
@@ -187,23 +226,42 @@ def simulate(
         )
     p = dm.parameter_vector(params, outputs=outputs)
     x_init = _initial_state(dm, x0)
+    names = OUTPUT_NAMES if outputs is None else tuple(outputs)
+    for name in names:
+        dm.output_index(name)
+    idx = tuple(OUTPUT_NAMES.index(nm) for nm in names)
     n = t.size - 1
     if isinstance(integrator, RK4):
         s = integrator.substeps
         h = np.diff(t)
-        frac = np.arange(2 * s + 1) / (2 * s)
-        stage_t = (t[:-1, None] + h[:, None] * frac[None, :]).ravel()
-        U = exc.values(stage_t).reshape(dm.nu, n * (2 * s + 1))
-        X = _horizon(dm, s, n)(x_init, U, p, t[:-1].reshape(1, -1), h.reshape(1, -1))
-        X = np.hstack([x_init.reshape(-1, 1), np.asarray(X).reshape(dm.nx, n)])
+        if exc.analytic:
+            U = np.zeros((0, n))
+            Ug = np.zeros((0, n + 1))
+        else:
+            frac = np.arange(2 * s + 1) / (2 * s)
+            stage_t = (t[:-1, None] + h[:, None] * frac[None, :]).ravel()
+            U = _stage_inputs(exc, stage_t, dm.nu, n, 2 * s + 1)
+            Ug = exc.values(t).reshape(dm.nu, t.size)
+        fn = _simulator(dm, exc, s, n, idx, integrator.compiled)
+        X, Y = fn(x_init, U, p, t.reshape(1, -1), h.reshape(1, -1), Ug)
+        X, Y = np.asarray(X), np.asarray(Y)
     elif isinstance(integrator, Adaptive):
         X = _adaptive(dm, integrator, exc, x_init, p, t)
+        Ug = exc.values(t).reshape(dm.nu, t.size)
+        out = dm.outputs.map(t.size)(X, Ug, p, t.reshape(1, -1))
+        Y = np.asarray(out)[list(idx), :]
     else:
         raise TypeError(f"integrator must be RK4(...) or Adaptive(...), got {integrator!r}")
-    Ug = exc.values(t).reshape(dm.nu, t.size)
-    Y = np.asarray(_output_map(dm, t.size)(X, Ug, p, t.reshape(1, -1)))
-    return Simulation(time=t, states=X.T.copy(), outputs=Y.T.copy(), inputs=Ug.T.copy(),
-                      state_names=dm.states, input_names=dm.inputs)
+    inputs = exc.values(t).reshape(dm.nu, t.size)
+    return Simulation(time=t, states=X.T.copy(), outputs=Y.T.copy(), inputs=inputs.T.copy(),
+                      state_names=dm.states, input_names=dm.inputs, output_names=names)
+
+
+def _stage_inputs(exc: Excitation, stage_t: np.ndarray, nu: int, n: int, m: int) -> np.ndarray:
+    """Inputs at the stage times as a ``(nu * m, n)`` array: column k stacks the ``m`` stage
+    input vectors of interval k (column-major, as ``reshape(U_k, nu, m)`` expects)."""
+    vals = exc.values(stage_t).reshape(nu, n, m)  # [channel, interval, stage]
+    return np.ascontiguousarray(vals.transpose(1, 2, 0).reshape(n, m * nu).T)
 
 
 def _adaptive(dm: DerivedModel, opts: Adaptive, exc: Excitation, x0: np.ndarray,
