@@ -30,7 +30,7 @@ def test_undamped_two_pendulums_conserve_energy_in_a_fixed_tank():
              + Pendulum("p2", mass=0.05, length=0.018, hinge_height=0.10))
     t = np.linspace(0.0, 30.0, 3001)
     sim = simulate(model, {"rig.dry_mass": 1.2}, t, NoExcitation(), integrator=TIGHT,
-                   x0={"p1.theta": 0.4, "p2.theta": -0.2}, outputs=("potential_energy",))
+                   x0={"p1.theta": 0.4, "p2.theta": -0.2}, outputs=("kinetic_energy", "potential_energy"))
     assert np.ptp(sim.state("p1.theta")) > 0.5  # it really swings
     assert _relative_drift(sim) < tol.ENERGY_DRIFT
 
@@ -125,7 +125,7 @@ def test_spherical_pendulum_conserves_energy_and_vertical_angular_momentum():
     t = np.linspace(0.0, 10.0, 1001)
     sim = simulate(model, {"rig.dry_mass": 0.0}, t, NoExcitation(), integrator=TIGHT,
                    x0={"p1.alpha": 0.5, "p1.beta": 0.1, "p1.beta_dot": 2.0},
-                   outputs=("potential_energy",))
+                   outputs=("kinetic_energy", "potential_energy"))
     assert _relative_drift(sim) < tol.ENERGY_DRIFT
     a, b = sim.state("p1.alpha"), sim.state("p1.beta")
     ad, bd = sim.state("p1.alpha_dot"), sim.state("p1.beta_dot")
@@ -156,7 +156,7 @@ def test_suspended_mass_oscillates_at_sqrt_k_over_m_and_conserves_energy():
     model = LateralRig() + SuspendedMass("s1", axes="xy", mass=m, height=0.05, stiffness_x=k, stiffness_y=2 * k)
     t = np.linspace(0.0, 4.0, 4001)
     sim = simulate(model, {"rig.dry_mass": 0.0}, t, integrator=TIGHT,
-                   x0={"s1.s_x": 0.01, "s1.s_y": 0.02}, outputs=("potential_energy",))
+                   x0={"s1.s_x": 0.01, "s1.s_y": 0.02}, outputs=("kinetic_energy", "potential_energy"))
     assert np.allclose(sim.state("s1.s_x"), 0.01 * np.cos(math.sqrt(k / m) * t), atol=1e-10)
     assert np.allclose(sim.state("s1.s_y"), 0.02 * np.cos(math.sqrt(2 * k / m) * t), atol=1e-10)
     assert _relative_drift(sim) < tol.ENERGY_DRIFT
