@@ -27,10 +27,8 @@ from __future__ import annotations
 import json
 import math
 import time
-from dataclasses import asdict, dataclass, field
+from dataclasses import dataclass, field
 from typing import Any, Union
-
-import numpy as np
 
 from . import _fem, _legacy, _ritz
 from ._modes import RawModes

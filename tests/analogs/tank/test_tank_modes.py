@@ -51,9 +51,8 @@ def test_capsule_ritz_and_fem_agree(fill):
     tank = Capsule(0.5, 0.4)
     ritz = predict(tank, fill=fill, method=Ritz(degree=80))
     fem = predict(tank, fill=fill, method=FiniteElements())
-    # the capsule has curvature jumps at the dome joints (mild singularities): looser
-    for a, b in zip(ritz.modes, fem.modes):
-        assert a.lam == pytest.approx(b.lam, rel=10 * LAMBDA_AGREEMENT)
+    for a, b in zip(ritz.modes, fem.modes):  # measured 1.4e-6 at 85 %
+        assert a.lam == pytest.approx(b.lam, rel=LAMBDA_AGREEMENT)
         assert abs(a.mass - b.mass) / ritz.liquid_mass < MASS_HEIGHT_AGREEMENT
 
 
