@@ -22,7 +22,7 @@ class RawModes:
     u_wall : ``U`` at the contact line ``(r_s, depth)`` ([U]).
     moment : ``integral (z (U_r + U/r) - r U_z) r dr dz`` over the meridian section, the
         pitch angular momentum integral of the mode (m^3 [U]).
-    iterations : basis size or number of unknowns used.
+    size : basis size (Ritz) or number of unknowns (finite elements).
     """
 
     lam: np.ndarray

@@ -11,7 +11,6 @@ largest distance from it to the wetted wall.
 
 from __future__ import annotations
 
-
 import numpy as np
 from scipy.linalg import eigh, svd
 
