@@ -724,7 +724,7 @@ def _toml_text(test: TestInfo, tank: Tank, liquid: Liquid, rig: Rig,
 
     def table(name: str, rows: list[tuple[str, Any, str]]) -> None:
         out.append(f"[{name}]")
-        width = max(len(k) + 3 + len(_toml_value(v)) for k, v, _ in rows)
+        width = max((len(k) + 3 + len(_toml_value(v)) for k, v, n in rows if n), default=0)
         for key, value, note in rows:
             text = f"{key} = {_toml_value(value)}"
             out.append(f"{text:<{width}}   # {note}" if note else text)
