@@ -78,7 +78,7 @@ def main(argv: list[str] | None = None) -> int:
     from .case import CaseError
 
     try:
-        status = args.run(args)
+        status = (getattr(args, "run", None) or args.func)(args)
     except (CaseError, ModelError, ParameterError, FileNotFoundError, FileExistsError,
             ValueError, KeyError) as err:
         msg = err.args[0] if isinstance(err, KeyError) and err.args else str(err)
