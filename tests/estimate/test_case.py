@@ -445,3 +445,33 @@ def test_write_invalid_case_leaves_no_files(tmp_path: Path) -> None:
     with pytest.raises(CaseError, match=r"column `force`: expected finite numbers"):
         write_case(tmp_path / "G1.toml", **args)
     assert list(tmp_path.iterdir()) == []
+
+
+# ---------------------------------------------------------------------------------------------
+# bundled examples
+
+EXAMPLES = Path(__file__).resolve().parents[2] / "examples"
+
+
+@pytest.mark.parametrize("name", ["A1", "A1_crank"])
+def test_bundled_examples_load_and_are_marked_synthetic(name: str) -> None:
+    case = load_case(EXAMPLES / f"{name}.toml")
+    assert case.n_samples == 3001 and case.sample_rate == pytest.approx(100.0)
+    assert case.test.note is not None and "SYNTHETIC" in case.test.note
+    assert "SYNTHETIC" in (EXAMPLES / f"{name}.toml").read_text().splitlines()[0]
+    assert (case.displacement is None) == (name == "A1_crank")
+
+
+def test_bundled_examples_are_reproducible(tmp_path: Path) -> None:
+    import json
+    import runpy
+
+    script = runpy.run_path(str(EXAMPLES / "make_example_cases.py"), run_name="not_main")
+    assert script["main"](["--out", str(tmp_path)]) == 0
+    assert script["main"](["--out", str(tmp_path)]) == 1  # refuses to overwrite
+    for name in ("A1", "A1_crank"):
+        new, old = load_case(tmp_path / f"{name}.toml"), load_case(EXAMPLES / f"{name}.toml")
+        np.testing.assert_allclose(new.force, old.force, rtol=1e-9, atol=1e-9)
+    params = json.loads((EXAMPLES / "A1_params.json").read_text())
+    assert sorted(params) == ["fixed.mass", "p1.damping", "p1.length", "p1.mass", "p1.stiffness"]
+    assert json.loads((tmp_path / "A1_params.json").read_text()) == pytest.approx(params)
