@@ -513,8 +513,7 @@ def _significant_frequencies(t: NDArray[np.float64], x: NDArray[np.float64]) -> 
 
 def _savgol_window(freqs: list[float], step: float, polyorder: int, n: int) -> int:
     """Largest odd window whose 2nd-derivative gain error at `freqs` is <= _SAVGOL_RTOL."""
-    best = polyorder + 3 - (polyorder + 3) % 2 + 1
-    best = best if best % 2 else best + 1
+    best = polyorder + 1 if polyorder % 2 == 0 else polyorder + 2  # smallest odd window
     w_max = min(n - (1 - n % 2), int(2.0 / step) | 1)
     for window in range(best, w_max + 1, 2):
         c = signal.savgol_coeffs(window, polyorder, deriv=2, delta=step)
