@@ -138,14 +138,29 @@ class FrameDeclaration(_Base):
     def gravity(self, value: me.Vector) -> None:
         self._shared.gravity = value
 
-    def add_input(self, local: str, unit: str) -> sp.Function:
+    def add_input(self, local: str, unit: str, *, derivatives: int = 2,
+                  derivative_of: sp.Function | None = None) -> sp.Function:
         """Declare a prescribed signal (a function of time) that the excitation supplies.
 
-        The signal and its first two time derivatives become model inputs called
-        ``"<rig>.<local>"``, ``"<rig>.<local>_dot"`` and ``"<rig>.<local>_ddot"``.
+        The signal and its first ``derivatives`` time derivatives (default 2) become model
+        inputs called ``"<rig>.<local>"``, ``"<rig>.<local>_dot"`` and
+        ``"<rig>.<local>_ddot"``. With ``derivative_of=s`` (``s`` a signal declared with
+        ``derivatives=0``), the input ``"<rig>.<local>"`` is the time derivative of ``s``
+        (e.g. an angular acceleration given alongside the angular velocity); the returned
+        expression is ``s.diff(t)``. Derivation fails if the equations need a derivative of
+        a signal that is not an input.
         """
-        sym = me.dynamicsymbols(f"{self._owner}.{local}")
-        self._shared.inputs.append((sym, f"{self._owner}.{local}", unit))
+        if derivatives not in (0, 1, 2):
+            raise ValueError(f"add_input derivatives must be 0, 1 or 2, got {derivatives!r}")
+        name = f"{self._owner}.{local}"
+        if derivative_of is not None:
+            if derivatives:
+                raise ValueError("add_input(derivative_of=...) declares a single input; "
+                                 "pass derivatives=0")
+            sym = derivative_of.diff(self.t)
+        else:
+            sym = me.dynamicsymbols(name)
+        self._shared.inputs.append((sym, name, unit, derivatives))
         return sym
 
 
@@ -188,4 +203,4 @@ class _Shared:
     tank: me.ReferenceFrame
     origin_position: me.Vector
     gravity: me.Vector
-    inputs: list[tuple[sp.Function, str, str]] = field(default_factory=list)
+    inputs: list[tuple[sp.Expr, str, str, int]] = field(default_factory=list)

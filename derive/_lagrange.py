@@ -9,6 +9,7 @@ from __future__ import annotations
 from dataclasses import dataclass
 
 import sympy as sp
+from sympy.core.function import AppliedUndef
 from sympy.physics import mechanics as me
 
 from analogs.component import Attachment, Rig
@@ -117,13 +118,14 @@ def assemble(model: Model) -> SymbolicModel:
     qd = tuple(sp.Symbol(f"qd{i}", real=True) for i in range(n))
     qdd = tuple(sp.Symbol(f"qdd{i}", real=True) for i in range(n))
     inputs, units, usyms, rule = [], [], [], {}
-    for j, (sig, name, unit) in enumerate(shared.inputs):
-        for order, suffix, uunit in ((2, "_ddot", f"{unit}/s^2"), (1, "_dot", f"{unit}/s"), (0, "", unit)):
+    for j, (sig, name, unit, derivatives) in enumerate(shared.inputs):
+        for order, suffix, uunit in ((0, "", unit), (1, "_dot", f"{unit}/s"),
+                                     (2, "_ddot", f"{unit}/s^2"))[:derivatives + 1]:
             sym = sp.Symbol(f"u{j}_{order}", real=True)
             rule[sig.diff(t, order) if order else sig] = sym
-        inputs += [name, f"{name}_dot", f"{name}_ddot"]
-        units += [unit, f"{unit}/s", f"{unit}/s^2"]
-        usyms += [rule[sig], rule[sig.diff(t)], rule[sig.diff(t, 2)]]
+            inputs.append(name + suffix)
+            units.append(uunit)
+            usyms.append(sym)
     for i, s in enumerate(qf):
         rule[s.diff(t, 2)] = qdd[i]
         rule[s.diff(t)] = qd[i]
@@ -138,12 +140,21 @@ def assemble(model: Model) -> SymbolicModel:
         plain(kinetic),
         plain(potential),
     )
+    M_plain, f_plain = M.applyfunc(plain), f.applyfunc(plain)
+    left = set().union(*(e.atoms(sp.Derivative, AppliedUndef)
+                         for e in (*M_plain, *f_plain, *outputs)))
+    if left:
+        named = {u: sp.Symbol(nm) for u, nm in zip(usyms, inputs)}
+        left = sorted(str(e.xreplace(named)) for e in left)
+        raise ValueError(
+            f"the equations of {model!r} need {', '.join(left)}, which no "
+            "input supplies; declare more derivatives with `add_input(..., derivatives=...)`")
     names = tuple(p.name for p in model.parameters)
     return SymbolicModel(
         coordinates=tuple(name for name, _ in coords),
         q=q, qd=qd, qdd=qdd,
         inputs=tuple(inputs), input_units=tuple(units), u=tuple(usyms),
         parameters=names, p=tuple(psym[nm] for nm in names), t=t,
-        mass_matrix=M.applyfunc(plain), forcing=f.applyfunc(plain),
+        mass_matrix=M_plain, forcing=f_plain,
         outputs=outputs, measured=tuple(rig.measured),
     )
