@@ -215,7 +215,7 @@ def export_c(
     name = _c_name(name)
     if int(substeps) != substeps or substeps < 1:
         raise ValueError(f"substeps must be a positive integer, got {substeps!r}")
-    folder = Path(folder)
+    folder = Path(folder).resolve()
     folder.mkdir(parents=True, exist_ok=True)
     files = {k: folder / f for k, f in {
         "header": f"{name}.h", "wrapper": f"{name}.c", "cg_c": f"{name}_casadi.c",

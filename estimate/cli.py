@@ -64,6 +64,10 @@ def _parser() -> argparse.ArgumentParser:
         _cli_tank = None
     if _cli_tank is not None:
         _cli_tank.add_parser(sub)
+    from . import _cli_export, _cli_montecarlo
+
+    _cli_export.add_parser(sub)
+    _cli_montecarlo.add_parser(sub)
     return parser
 
 

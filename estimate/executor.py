@@ -15,9 +15,11 @@ __all__ = ["DaskExecutor", "Executor", "LocalExecutor", "chunks", "executor_for"
 
 
 class Executor:
-    """Runs ``fn`` over ``items`` and returns the results in order."""
+    """Runs ``fn(item, shared=shared)`` for each of ``items`` and returns the results in
+    order; ``shared`` (large data all tasks need) is sent to each worker once."""
 
-    def map(self, fn: Callable[[Any], Any], items: Sequence[Any]) -> list[Any]:
+    def map(self, fn: Callable[[Any, Any], Any], items: Sequence[Any], shared: Any = None
+            ) -> list[Any]:
         raise NotImplementedError
 
     def close(self) -> None:
@@ -38,8 +40,9 @@ class Executor:
 class LocalExecutor(Executor):
     """Runs the tasks one after another in this process."""
 
-    def map(self, fn: Callable[[Any], Any], items: Sequence[Any]) -> list[Any]:
-        return [fn(item) for item in items]
+    def map(self, fn: Callable[[Any, Any], Any], items: Sequence[Any], shared: Any = None
+            ) -> list[Any]:
+        return [fn(item, shared=shared) for item in items]
 
     def __repr__(self) -> str:
         return "LocalExecutor()"
@@ -92,8 +95,10 @@ class DaskExecutor(Executor):
     def workers(self) -> int:
         return max(1, len(self.client.scheduler_info().get("workers", {})))
 
-    def map(self, fn: Callable[[Any], Any], items: Sequence[Any]) -> list[Any]:
-        futures = self.client.map(fn, list(items), pure=False)
+    def map(self, fn: Callable[[Any, Any], Any], items: Sequence[Any], shared: Any = None
+            ) -> list[Any]:
+        data = self.client.scatter(shared, broadcast=True) if shared is not None else None
+        futures = self.client.map(fn, list(items), shared=data, pure=False)
         return self.client.gather(futures)
 
     def close(self) -> None:

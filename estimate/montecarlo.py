@@ -220,27 +220,23 @@ _WORKER_CACHE: dict[str, ca.Function] = {}
 
 @dataclass(frozen=True)
 class _Task:
-    """One batch: the serialized batch function (shipped to workers) and its parameters."""
+    """One batch: its parameter columns; the serialized batch function is shared."""
 
     key: str
-    function: str
     P: np.ndarray
     compile: bool
 
-    def __call__(self) -> np.ndarray:
-        fn = _WORKER_CACHE.get(self.key)
-        if fn is None:
-            fn = ca.Function.deserialize(self.function)
-            if self.compile:
-                from derive._compile import compiled
 
-                fn = compiled(fn)
-            _WORKER_CACHE[self.key] = fn
-        return np.asarray(fn(self.P)).T
+def _run_task(task: _Task, shared: str) -> np.ndarray:
+    fn = _WORKER_CACHE.get(task.key)
+    if fn is None:
+        fn = ca.Function.deserialize(shared)
+        if task.compile:
+            from derive._compile import compiled
 
-
-def _run_task(task: _Task) -> np.ndarray:
-    return task()
+            fn = compiled(fn)
+        _WORKER_CACHE[task.key] = fn
+    return np.asarray(fn(task.P)).T
 
 
 @dataclass(frozen=True)
@@ -407,8 +403,8 @@ class MonteCarlo:
             Pb = P[a:b]
             if Pb.shape[0] < batch:
                 Pb = np.vstack([Pb, np.repeat(Pb[-1:], batch - Pb.shape[0], axis=0)])
-            tasks.append(_Task(key, text, np.ascontiguousarray(Pb.T), compile))
-        results = executor.map(_run_task, tasks)
+            tasks.append(_Task(key, np.ascontiguousarray(Pb.T), compile))
+        results = executor.map(_run_task, tasks, shared=text)
         Y = np.vstack(results)[:samples]  # (samples, len(names) * (n + 1)), output by output
         nt = t.size
         outputs = {name: Y[:, i * nt:(i + 1) * nt] for i, name in enumerate(names)}

@@ -144,3 +144,45 @@ def test_unknown_covariance_parameter_is_reported(tmp_path):
                   "values": {**fit.values, "p9.mass": 1.0}})
     with pytest.raises(ValueError, match="p9.mass are not parameters of the model"):
         monte_carlo(dm, t, exc, fit2, 4, fixed=fixed)
+
+
+def test_cli_montecarlo_local(tmp_path, capsys):
+    from pathlib import Path
+
+    from estimate.cli import main
+
+    examples = Path(__file__).resolve().parents[2] / "examples"
+    fit = fit_json(tmp_path / "fit.json")
+    out = tmp_path / "mc"
+    status = main(["montecarlo", str(fit), str(examples / "A1.toml"), "--samples", "12",
+                   "--seed", "5", "--local", "--batch-size", "8", "--out", str(out)])
+    assert status == 0
+    data = json.loads((out / "montecarlo.json").read_text())
+    assert data["samples"] == 12 and data["seed"] == 5
+    assert len(data["envelopes"]["force_x"]["p50"]) == len(data["time"])
+    assert (out / "envelope.png").stat().st_size > 0
+    assert "peak_force_x" in capsys.readouterr().out
+    assert main(["montecarlo", str(fit), str(examples / "A1.toml"), "--samples", "12",
+                 "--local", "--out", str(out)]) == 2  # exists, no --overwrite
+
+
+def test_cli_export_c_and_fmu(tmp_path, capsys):
+    from derive.export_c import has_c_compiler
+    from estimate.cli import main
+
+    fit = fit_json(tmp_path / "fit.json")
+    assert main(["export", str(fit)]) == 2
+    assert "nothing to write" in capsys.readouterr().err
+    assert main(["export", str(fit), "--out", str(tmp_path / "c"), "--integrator", "adaptive"]) == 2
+    assert "cannot be generated" in capsys.readouterr().err
+    args = ["export", str(fit), "--out", str(tmp_path / "c")]
+    if not has_c_compiler():
+        args.append("--no-build")
+    assert main(args) == 0
+    header = (tmp_path / "c" / "slosh_model.h").read_text()
+    assert "p1.length" in header and "0.05529" in header
+    assert has_c_compiler() is False or (tmp_path / "c" / "simulate").exists()
+    assert main(["export", str(fit), "--out", str(tmp_path / "v"), "--interface", "vehicle",
+                 "--planar", "--no-build", "--set", "p1.hinge_height=0.1",
+                 "--set", "fixed.height=0.05", "--set", "fixed.inertia=0.001"]) == 0
+    assert "vehicle.alpha_y" in (tmp_path / "v" / "slosh_model.h").read_text()
