@@ -47,7 +47,7 @@ static int cmp(const void *a, const void *b) {
 }
 
 int main(int argc, char **argv) {
-    const int n = atoi(argv[1]), repeat = atoi(argv[2]);
+    const int n = argc > 1 ? atoi(argv[1]) : 3000, repeat = argc > 2 ? atoi(argv[2]) : 200;
     const double h = 0.01, w = 2.0 * 3.141592653589793 * 1.855, A = 0.005;
     double *U = malloc(sizeof(double) * (size_t)n * SLOSH_MODEL_NU * SLOSH_MODEL_NSTAGES);
     double *times = malloc(sizeof(double) * (size_t)repeat), x[SLOSH_MODEL_NX], y[SLOSH_MODEL_NY];
