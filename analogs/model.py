@@ -156,6 +156,10 @@ class Model:
             raise ModelError(problems)
         return self
 
+    def explicit_values(self) -> dict[str, float]:
+        """Parameter values given explicitly to component constructors (not declared defaults)."""
+        return {f"{c.prefix}.{k}": v for c in self._components for k, v in c._values.items()}
+
     def resolve(self, values: Mapping[str, float] | None = None) -> dict[str, float | None]:
         """Parameter values: ``values`` over defaults, checked against names and bounds.
 

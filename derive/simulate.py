@@ -78,13 +78,14 @@ class Simulation:
 def rk4_step(dm: DerivedModel, substeps: int = 1) -> ca.Function:
     """``step(x, U, p, t, h) -> x_next``: ``substeps`` RK4 steps over ``[t, t + h]``.
 
-    ``U`` holds the inputs at the ``2 * substeps + 1`` equally spaced stage times of the
-    interval, one column each.
+    ``U`` (a column of ``nu * (2 substeps + 1)`` values) stacks the input vectors at the
+    ``2 * substeps + 1`` equally spaced stage times of the interval, first time first.
     """
     key = ("rk4_step", substeps)
     if key not in dm._memo:
         x0 = ca.SX.sym("x", dm.nx)
-        U = ca.SX.sym("U", dm.nu, 2 * substeps + 1)
+        Uv = ca.SX.sym("U", dm.nu * (2 * substeps + 1))
+        U = ca.reshape(Uv, dm.nu, 2 * substeps + 1)
         p = ca.SX.sym("p", len(dm.parameter_names))
         t = ca.SX.sym("t")
         h = ca.SX.sym("h")
@@ -98,7 +99,7 @@ def rk4_step(dm: DerivedModel, substeps: int = 1) -> ca.Function:
             k3 = dm.rhs(x + hs / 2 * k2, um, p, ti + hs / 2)
             k4 = dm.rhs(x + hs * k3, ub, p, ti + hs)
             x = x + hs / 6 * (k1 + 2 * k2 + 2 * k3 + k4)
-        dm._memo[key] = ca.Function("rk4_step", [x0, U, p, t, h], [x],
+        dm._memo[key] = ca.Function("rk4_step", [x0, Uv, p, t, h], [x],
                                     ["x", "U", "p", "t", "h"], ["x_next"])
     return dm._memo[key]
 
@@ -130,7 +131,7 @@ def _simulator(dm: DerivedModel, exc: Excitation, substeps: int, n: int,
         U = ca.reshape(Uk, dm.nu, m)
         ug = ca.SX.sym("ug", dm.nu)
         u_grid = ug
-    step = ca.Function("step", [x, Uk, p, t, h], [rk4_step(dm, substeps)(x, U, p, t, h)])
+    step = ca.Function("step", [x, Uk, p, t, h], [rk4_step(dm, substeps)(x, ca.vec(U), p, t, h)])
     y = dm.outputs(x, u_grid, p, t)
     out = ca.Function("out", [x, ug, p, t], [ca.vertcat(*[y[i] for i in outputs])])
     horizon = step.mapaccum("horizon", n)

@@ -1,0 +1,318 @@
+"""Estimation as one NLP with exact derivatives: IPOPT through CasADi.
+
+Decision variables are the scaled parameters plus the states at the nodes of the chosen
+transcription; the cost is the sum of squared force residuals (or the seed's
+``sum((|E| - |S|)^2)``). After the solve, residual sensitivities through a single-shooting
+RK4 rollout (forward AD) give the Gauss-Newton covariance and the identifiability check.
+"""
+
+from __future__ import annotations
+
+import math
+import sys
+import time
+from collections.abc import Callable, Mapping
+from dataclasses import dataclass
+
+import casadi as ca
+import numpy as np
+
+from derive import OUTPUT_NAMES, RK4, rk4_step, simulate
+
+from .identifiability import analyse
+from .problem import FitProblem
+from .result import FitResult, derived_quantities
+from .signals import lowpass
+from .transcription import MultipleShooting, Transcription
+
+__all__ = ["fit", "Hessian"]
+
+_IPOPT_DEFAULTS = {
+    "ipopt.print_level": 0, "print_time": False, "ipopt.sb": "yes", "ipopt.tol": 1e-8,
+    "ipopt.max_iter": 300, "ipopt.mu_strategy": "adaptive", "ipopt.linear_solver": "mumps",
+}
+_IPOPT_HINTS = {
+    "Maximum_Iterations_Exceeded": "raise `ipopt.max_iter` in solver_options, or start closer "
+                                    "(check [prediction] and the drive frequency)",
+    "Restoration_Failed": "the initial guess is far from feasible: check the excitation and the "
+                          "initial values",
+    "Infeasible_Problem_Detected": "bounds exclude every solution: widen `bounds`",
+    "Invalid_Number_Detected": "a parameter reached a value where the model is undefined: "
+                               "tighten bounds",
+}
+
+
+@dataclass(frozen=True)
+class Hessian:
+    """Hessian of the Lagrangian given to IPOPT: ``"gauss-newton"`` (J_r^T J_r of the
+    residuals, cheaper and positive semidefinite) or ``"exact"`` (CasADi AD)."""
+
+    kind: str = "gauss-newton"
+
+    def __post_init__(self) -> None:
+        if self.kind not in ("gauss-newton", "exact"):
+            raise ValueError(f"Hessian kind must be 'gauss-newton' or 'exact', got {self.kind!r}")
+
+
+class _Recorder(ca.Callback):
+    """IPOPT iteration callback: records parameter trajectories and prints progress."""
+
+    def __init__(self, nw: int, ng: int, ntheta: int, scales: np.ndarray, cost_scale: float,
+                 printer: Callable[[int, float, np.ndarray], None] | None) -> None:
+        ca.Callback.__init__(self)
+        self.nw, self.ng, self.ntheta = nw, ng, ntheta
+        self.scales, self.cost_scale = scales, cost_scale
+        self.thetas: list[np.ndarray] = []
+        self.costs: list[float] = []
+        self.printer = printer
+        self.construct("fit_iterations", {})
+
+    def get_n_in(self):
+        return ca.nlpsol_n_out()
+
+    def get_n_out(self):
+        return 1
+
+    def get_name_in(self, i):
+        return ca.nlpsol_out(i)
+
+    def get_name_out(self, i):
+        return "ret"
+
+    def get_sparsity_in(self, i):
+        n = ca.nlpsol_out(i)
+        if n == "f":
+            return ca.Sparsity.scalar()
+        if n in ("x", "lam_x"):
+            return ca.Sparsity.dense(self.nw)
+        if n in ("g", "lam_g"):
+            return ca.Sparsity.dense(self.ng)
+        return ca.Sparsity(0, 0)
+
+    def eval(self, arg):
+        theta = np.asarray(arg[0]).ravel()[: self.ntheta] * self.scales
+        cost = float(arg[1]) * self.cost_scale
+        self.thetas.append(theta)
+        self.costs.append(cost)
+        if self.printer is not None:
+            self.printer(len(self.costs) - 1, cost, theta)
+        return [0]
+
+
+def _progress_printer(names):
+    def show(k, cost, theta):
+        vals = "  ".join(f"{n}={v:.5g}" for n, v in zip(names, theta))
+        print(f"\riter {k:3d}  cost {cost:.6g}  {vals}"[:200], end="", file=sys.stderr, flush=True)
+    return show
+
+
+def _measured_output(dm, channel: str) -> ca.Function:
+    x = ca.SX.sym("x", dm.nx)
+    u = ca.SX.sym("u", dm.nu)
+    p = ca.SX.sym("p", len(dm.parameter_names))
+    t = ca.SX.sym("t")
+    y = dm.outputs(x, u, p, t)[OUTPUT_NAMES.index(channel)]
+    return ca.Function("measured", [x, u, p, t], [y])
+
+
+def _parameter_column(dm, values: Mapping[str, float], theta: ca.MX, problem: FitProblem,
+                      case: int) -> ca.MX:
+    """The model's parameter vector for one case as an MX of the scaled decision vector."""
+    entries = []
+    for name in dm.parameter_names:
+        hit = None
+        for j, e in enumerate(problem.estimated):
+            if e.parameter == name and (e.case is None or e.case == case):
+                hit = theta[j] * e.scale
+        if hit is None:
+            v = values.get(name)
+            hit = ca.MX(0.0 if v is None or not math.isfinite(v) else float(v))
+        entries.append(hit)
+    return ca.vertcat(*entries)
+
+
+def _measured_force(problem: FitProblem, i: int) -> np.ndarray:
+    case = problem.experiments[i].case
+    if problem.force_cutoff_hz is None:
+        return np.asarray(case.force, float)
+    return lowpass(case.time, case.force, cutoff_hz=problem.force_cutoff_hz)
+
+
+def fit(problem: FitProblem, *, transcription: Transcription = MultipleShooting(),
+        hessian: Hessian = Hessian(), cost: str = "squared", initial_state: str = "rest",
+        solver_options: Mapping[str, object] | None = None,
+        progress: bool | None = None) -> FitResult:
+    """Estimate the parameters of ``problem``.
+
+    Parameters
+    ----------
+    problem : FitProblem
+        Cases, model and the parameters to estimate (:meth:`FitProblem.build`).
+    transcription : MultipleShooting or Collocation
+        How the dynamics enter the NLP (default: multiple shooting, one RK4 step per sample).
+    hessian : Hessian
+        ``Hessian("gauss-newton")`` (default) or ``Hessian("exact")``.
+    cost : {"squared", "abs"}
+        ``"squared"``: sum of squared force residuals (N^2). ``"abs"``: the seed's
+        ``sum((|E| - |S|)^2)``, with a smooth absolute value.
+    initial_state : {"rest", "free"}
+        Start every case at rest (the tests start from rest) or estimate the initial state.
+    solver_options : mapping, optional
+        Options passed to ``casadi.nlpsol`` (e.g. ``{"ipopt.max_iter": 500}``).
+    progress : bool, optional
+        Print iteration and cost live; default: only when stderr is a terminal.
+
+    Returns
+    -------
+    FitResult
+        Estimates with standard errors, correlations, identifiability, derived quantities,
+        cost, residuals, solver status and the parameter trajectories over iterations.
+    """
+    if cost not in ("squared", "abs"):
+        raise ValueError(f"cost must be 'squared' or 'abs', got {cost!r}")
+    if initial_state not in ("rest", "free"):
+        raise ValueError(f"initial_state must be 'rest' or 'free', got {initial_state!r}")
+    if progress is None:
+        progress = sys.stderr.isatty()
+    t_start = time.perf_counter()
+    problem.check()
+    est = problem.estimated
+    scales = np.array([e.scale for e in est])
+    theta_s = ca.MX.sym("theta", len(est))
+    ws, w0s, gs, rs = [theta_s], [problem.initial / scales], [], []
+    measured = []
+    for i, exp in enumerate(problem.experiments):
+        dm, case = exp.derived, exp.case
+        t = np.asarray(case.time, float)
+        values0 = problem.case_values(i, problem.initial)
+        p_i = _parameter_column(dm, problem.fixed[i], theta_s, problem, i)
+        if dm.nx:
+            guess = simulate(dm, values0, t, exp.excitation, integrator=RK4()).states.T
+        else:
+            guess = np.zeros((0, t.size))
+        x0 = np.zeros(dm.nx) if initial_state == "rest" else None
+        block = transcription.block(dm, p_i, t, exp.excitation, guess, x0)
+        Ug = exp.excitation.values(t) if dm.nu else np.zeros((0, t.size))
+        out = _measured_output(dm, dm.measured[0]).map(t.size)
+        Y = out(block.X, ca.DM(Ug), p_i, ca.DM(t).T).T
+        F = _measured_force(problem, i)
+        measured.append(F)
+        if cost == "squared":
+            r = Y - ca.DM(F)
+        else:
+            eps = 1e-3 * float(np.std(F))
+            r = ca.sqrt(Y**2 + eps**2) - ca.DM(np.abs(F))
+        ws.append(block.w)
+        w0s.append(block.w0)
+        gs.append(block.g)
+        rs.append(r)
+    w = ca.vertcat(*ws)
+    g = ca.vertcat(*gs)
+    r_all = ca.vertcat(*rs)
+    norm = float(np.mean(np.concatenate(measured) ** 2)) or 1.0
+    f = 0.5 * ca.sumsqr(r_all) / norm
+    lbx = np.full(w.numel(), -np.inf)
+    ubx = np.full(w.numel(), np.inf)
+    lbx[: len(est)] = [e.lower / e.scale for e in est]
+    ubx[: len(est)] = [e.upper / e.scale for e in est]
+    opts = dict(_IPOPT_DEFAULTS)
+    if hessian.kind == "gauss-newton":
+        Jr = ca.jacobian(r_all, w)
+        sigma = ca.MX.sym("sigma")
+        lam = ca.MX.sym("lam", g.numel())
+        H = sigma * ca.mtimes(Jr.T, Jr) / norm
+        opts["hess_lag"] = ca.Function("nlp_hess_l", [w, ca.MX(0, 1), sigma, lam],
+                                       [ca.triu(H)], ["x", "p", "lam_f", "lam_g"], ["triu_hess_gamma_x_x"])
+    recorder = _Recorder(w.numel(), g.numel(), len(est), scales, 2 * norm,
+                         _progress_printer(problem.names) if progress else None)
+    opts["iteration_callback"] = recorder
+    opts.update(dict(solver_options or {}))
+    solver = ca.nlpsol("fit", "ipopt", {"x": w, "f": f, "g": g}, opts)
+    sol = solver(x0=np.concatenate(w0s), lbx=lbx, ubx=ubx, lbg=0, ubg=0)
+    if progress:
+        print(file=sys.stderr)
+    stats = solver.stats()
+    theta = np.asarray(sol["x"]).ravel()[: len(est)] * scales
+    seconds_solve = time.perf_counter() - t_start
+    return _result(problem, theta, stats, recorder, measured, cost, seconds_solve, t_start,
+                   transcription)
+
+
+def _rollout_jacobian(problem: FitProblem, theta: np.ndarray, measured: list[np.ndarray]):
+    """Residuals and their Jacobian w.r.t. the (unscaled) estimates, by single-shooting RK4."""
+    th = ca.MX.sym("theta", len(theta))
+    rs = []
+    for i, exp in enumerate(problem.experiments):
+        dm, case = exp.derived, exp.case
+        t = np.asarray(case.time, float)
+        p_i = _parameter_column(dm, problem.fixed[i], th, _unit_scaled(problem), i)
+        out = _measured_output(dm, dm.measured[0]).map(t.size)
+        Ug = exp.excitation.values(t) if dm.nu else np.zeros((0, t.size))
+        if dm.nx:
+            U = MultipleShooting().inputs(exp.excitation, t, dm.nu)
+            horizon = rk4_step(dm, 1).mapaccum(t.size - 1)
+            X = ca.horzcat(ca.DM.zeros(dm.nx), horizon(ca.DM.zeros(dm.nx), ca.DM(U), p_i,
+                                                        ca.DM(t[:-1]).T, ca.DM(np.diff(t)).T))
+        else:
+            X = ca.MX(0, t.size)
+        rs.append(out(X, ca.DM(Ug), p_i, ca.DM(t).T).T - ca.DM(measured[i]))
+    r = ca.vertcat(*rs)
+    fn = ca.Function("rollout", [th], [r, ca.jacobian(r, th)])
+    R, J = fn(theta)
+    return np.asarray(R).ravel(), np.asarray(J)
+
+
+def _unit_scaled(problem: FitProblem) -> FitProblem:
+    from dataclasses import replace
+
+    from .problem import Estimated
+
+    est = tuple(Estimated(e.name, e.parameter, e.case, e.unit, e.initial, e.lower, e.upper, 1.0)
+                for e in problem.estimated)
+    return replace(problem, estimated=est)
+
+
+def _result(problem, theta, stats, recorder, measured, cost, seconds_solve, t_start, transcription):
+    resid, J = _rollout_jacobian(problem, theta, measured)
+    n, k = resid.size, theta.size
+    ssr = float(resid @ resid)
+    dof = max(n - k, 1)
+    sigma2 = ssr / dof
+    JtJ = J.T @ J
+    warnings = []
+    try:
+        cov = sigma2 * np.linalg.inv(JtJ)
+        if not np.all(np.isfinite(cov)):
+            raise np.linalg.LinAlgError
+    except np.linalg.LinAlgError:
+        cov = sigma2 * np.linalg.pinv(JtJ)
+        warnings.append("the residual sensitivity is singular: covariance from a pseudo-inverse")
+    stderr = np.sqrt(np.clip(np.diag(cov), 0, None))
+    scales = np.array([e.scale for e in problem.estimated])
+    d = np.sqrt(np.diag(cov))
+    with np.errstate(invalid="ignore", divide="ignore"):
+        corr = np.nan_to_num(cov / np.outer(d, d))
+    ident = analyse(J, scales, problem.names, sigma2, corr)
+    status = stats.get("return_status", "unknown")
+    converged = bool(stats.get("success", False))
+    if not converged:
+        hint = _IPOPT_HINTS.get(status, "see IPOPT's status; try other initial values")
+        warnings.append(f"IPOPT did not converge ({status}): {hint}")
+    for e, v in zip(problem.estimated, theta):
+        span = e.upper - e.lower
+        if math.isfinite(span) and span > 0 and min(v - e.lower, e.upper - v) < 1e-4 * span:
+            warnings.append(f"`{e.name}` = {v:.6g} {e.unit} is at its bound [{e.lower:.6g}, {e.upper:.6g}]")
+    F_all = np.concatenate(measured)
+    derived = derived_quantities(problem, theta, cov)
+    return FitResult(
+        problem=problem,
+        values=theta, stderr=stderr, covariance=cov,
+        cost=ssr, rms_residual=math.sqrt(ssr / n),
+        r_squared=1 - ssr / float(np.sum((F_all - F_all.mean()) ** 2)),
+        n_samples=n, iterations=int(stats.get("iter_count", len(recorder.costs))),
+        seconds=time.perf_counter() - t_start, converged=converged, status=status,
+        warnings=tuple(warnings), identifiability=ident, derived=derived,
+        history=np.array(recorder.thetas), cost_history=np.array(recorder.costs),
+        residuals=tuple(np.split(resid, np.cumsum([m.size for m in measured])[:-1])),
+        measured=tuple(measured), cost_kind=cost, transcription=repr(transcription),
+    )

@@ -1,0 +1,83 @@
+"""Initial values, bounds and scales of estimated parameters, from the tank prediction."""
+
+from __future__ import annotations
+
+import math
+from collections.abc import Mapping
+
+from analogs import Model
+
+from .case import Case
+
+__all__ = ["predicted_values", "length_bounds", "nominal_scale", "LENGTH_BAND"]
+
+#: Pendulum lengths are kept within +/-20 % of the prediction, as the seed did.
+LENGTH_BAND = 0.20
+
+
+def _tank_prediction(case: Case, modes: int):
+    from analogs.tank import Cylinder, Liquid, Sphere, predict
+
+    shape = case.tank.shape
+    R = case.tank.radius
+    tank = Sphere(R) if shape == "sphere" else Cylinder(R, 2 * R)
+    liquid = Liquid(density=case.liquid.density, viscosity=case.liquid.kinematic_viscosity)
+    return predict(tank, fill=case.tank.fill_fraction, liquid=liquid, gravity=case.rig.gravity,
+                   modes=modes, diaphragm=case.tank.diaphragm)
+
+
+def predicted_values(case: Case, model: Model) -> dict[str, float]:
+    """Predicted analog parameters for the components of ``model``.
+
+    ``[prediction]`` of the case gives the first mode and the fixed mass; the tank modal
+    analysis (:mod:`analogs.tank`, exact potential flow) gives higher modes, hinge heights
+    and everything when the case has no ``[prediction]``. Hinge springs and extra dampers
+    start at zero; hinge dampers from the predicted damping ratio:
+    ``c = 2 zeta m L^2 omega`` with ``omega = sqrt(g / L)``.
+    """
+    g = case.rig.gravity
+    pendulums = [n for n in model.names if n.startswith("p") and n[1:].isdigit()]
+    n_modes = max([int(n[1:]) for n in pendulums] or [1])
+    pred = _tank_prediction(case, max(n_modes, 1))
+    out: dict[str, float] = {}
+    modes = {f"p{i + 1}": m for i, m in enumerate(pred.modes)}
+    for name, mode in modes.items():
+        out |= {f"{name}.mass": mode.mass, f"{name}.length": mode.length,
+                f"{name}.hinge_height": mode.hinge_height}
+        zeta = mode.damping_ratio if math.isfinite(mode.damping_ratio) else 0.01
+        out[f"{name}.zeta"] = zeta
+    out |= {"fixed.mass": pred.fixed_mass.mass, "fixed.height": pred.fixed_mass.height,
+            "fixed.inertia": pred.fixed_mass.inertia}
+    if case.prediction is not None:
+        pr = case.prediction
+        out |= {"p1.mass": pr.pendulum_mass, "p1.length": pr.pendulum_length,
+                "fixed.mass": pr.fixed_mass, "p1.zeta": pr.damping_ratio}
+    for name in pendulums:
+        m, L = out[f"{name}.mass"], out[f"{name}.length"]
+        zeta = out.pop(f"{name}.zeta")
+        out[f"{name}.damping"] = 2 * zeta * m * L**2 * math.sqrt(g / L)
+        out[f"{name}.stiffness"] = 0.0
+        out[f"{name}.quadratic_damping"] = 0.0
+        out[f"{name}.diaphragm_stiffness"] = 0.0
+        out[f"{name}.diaphragm_damping"] = 0.0
+    return {k: v for k, v in out.items() if not k.endswith(".zeta")}
+
+
+def length_bounds(predicted_length: float) -> tuple[float, float]:
+    """Bounds of a pendulum length around its prediction (+/-20 %)."""
+    return (1 - LENGTH_BAND) * predicted_length, (1 + LENGTH_BAND) * predicted_length
+
+
+def nominal_scale(name: str, value: float, values: Mapping[str, float], gravity: float) -> float:
+    """Typical magnitude of a parameter, used to scale the NLP variables to about 1."""
+    comp, local = name.split(".", 1)
+    m, L = values.get(f"{comp}.mass", 1.0), values.get(f"{comp}.length", 0.05)
+    omega = math.sqrt(gravity / L) if L > 0 else 10.0
+    physical = {
+        "stiffness": m * gravity * L, "diaphragm_stiffness": m * gravity * L,
+        "damping": 0.05 * m * L**2 * omega, "diaphragm_damping": 0.05 * m * L**2 * omega,
+        "quadratic_damping": 0.05 * m * L**2, "flywheel_angle": 1.0, "omega_correction": 0.1,
+    }
+    if local in physical:
+        return max(abs(value), physical[local])
+    return abs(value) if value != 0 else 1.0

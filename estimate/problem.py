@@ -1,0 +1,177 @@
+"""The estimation problem: cases, model, which parameters are estimated (shared or per
+case), their initial values, bounds and scales. Built once, never mutated."""
+
+from __future__ import annotations
+
+import math
+from collections.abc import Mapping, Sequence
+from dataclasses import dataclass, field
+
+import numpy as np
+
+from analogs import Model
+
+from .case import Case
+from .experiment import Experiment, experiment
+from .initial import length_bounds, nominal_scale, predicted_values
+
+__all__ = ["FitProblem", "Estimated", "PER_CASE"]
+
+#: Rig parameters estimated separately for every case (crank phase and speed).
+PER_CASE = ("rig.omega_correction", "rig.flywheel_angle")
+
+
+@dataclass(frozen=True)
+class Estimated:
+    """One estimated parameter: ``name`` (with ``"<case id>:"`` prefix for per-case ones),
+    the model parameter it sets, its case index (``None`` when shared), unit, initial
+    value, bounds and scale."""
+
+    name: str
+    parameter: str
+    case: int | None
+    unit: str
+    initial: float
+    lower: float
+    upper: float
+    scale: float
+
+
+@dataclass(frozen=True)
+class FitProblem:
+    """Cases and a model with the parameters to estimate.
+
+    Use :meth:`build`. ``fixed[i]`` are the values case ``i`` fixes (rig values, and
+    parameters the user holds), ``estimated`` the decision parameters.
+    """
+
+    model: Model
+    experiments: tuple[Experiment, ...]
+    estimated: tuple[Estimated, ...]
+    fixed: tuple[Mapping[str, float], ...]
+    force_cutoff_hz: float | None = 10.0
+    notes: tuple[str, ...] = field(default=())
+
+    @classmethod
+    def build(cls, cases: Case | Sequence[Case], model: Model, *,
+              estimate: Sequence[str] | None = None,
+              hold: Mapping[str, float] | None = None,
+              initial: Mapping[str, float] | None = None,
+              bounds: Mapping[str, tuple[float, float]] | None = None,
+              force_cutoff_hz: float | None = 10.0) -> "FitProblem":
+        """Set up the estimation of ``model`` on ``cases``.
+
+        Parameters
+        ----------
+        cases : Case or sequence of Case
+            Test cases; physical parameters are shared, crank phase and speed corrections
+            (:data:`PER_CASE`) are estimated per case.
+        model : analogs.Model
+            The analog model (its rig must match the cases' excitation).
+        estimate : sequence of str, optional
+            Parameters to estimate. Default: every parameter the equations of motion and
+            the measured force depend on, except the rig values the case file fixes.
+        hold : mapping, optional
+            Values of parameters held fixed (not estimated).
+        initial : mapping, optional
+            Initial values over the prediction (``[prediction]`` or tank modal analysis).
+        bounds : mapping, optional
+            Bounds over the defaults (physical bounds; pendulum lengths +/-20 % of the
+            prediction).
+        force_cutoff_hz : float or None, default 10
+            Zero-phase low-pass of the measured force before fitting, as the seed did.
+        """
+        cases = (cases,) if isinstance(cases, Case) else tuple(cases)
+        if not cases:
+            raise ValueError("no cases to fit")
+        model = model.validate()
+        hold, initial_user, bounds_user = dict(hold or {}), dict(initial or {}), dict(bounds or {})
+        exps = tuple(experiment(c, model) for c in cases)
+        dm = exps[0].derived
+        params = {p.name: p for p in dm.parameters}
+        unknown = sorted((set(hold) | set(initial_user) | set(bounds_user) | set(estimate or ()))
+                         - set(params))
+        if unknown:
+            raise KeyError(f"unknown parameter{'s' if len(unknown) > 1 else ''} "
+                           f"{', '.join(f'`{u}`' for u in unknown)}; the model's parameters are "
+                           + ", ".join(params))
+        rig_fixed = set().union(*(e.fixed for e in exps))
+        needed = dm.needed_parameters()
+        if estimate is None:
+            names = [n for n in needed if n not in rig_fixed and n not in hold]
+        else:
+            names = list(estimate)
+            clash = sorted(set(names) & set(hold))
+            if clash:
+                raise ValueError(f"parameters both estimated and held: {', '.join(clash)}")
+        predicted = predicted_values(cases[0], model)
+        explicit = model.explicit_values()
+        notes = []
+        start: dict[str, float] = {}
+        for n in params:
+            # user's initial value > value given to a constructor > prediction > declared default
+            candidates = (initial_user.get(n), hold.get(n), explicit.get(n), predicted.get(n),
+                          params[n].default)
+            v = next((c for c in candidates if c is not None), None)
+            if v is not None:
+                start[n] = float(v)
+        missing = [n for n in names if n not in start]
+        if missing:
+            raise ValueError(f"no initial value for {', '.join(missing)}: give `initial`")
+        g = cases[0].rig.gravity
+        est = []
+        for n in names:
+            p = params[n]
+            lo, hi = p.lower, p.upper
+            if n.endswith(".length") and n in predicted and n not in bounds_user:
+                lo, hi = length_bounds(predicted[n])
+                notes.append(f"`{n}` bounded to +/-20 % of the predicted {predicted[n]:.4g} m")
+            lo, hi = bounds_user.get(n, (lo, hi))
+            x0 = min(max(start[n], lo), hi)
+            scale = nominal_scale(n, x0, start, g)
+            targets = range(len(cases)) if n in PER_CASE else [None]
+            for i in targets:
+                label = n if i is None else f"{cases[i].test.id}:{n}"
+                est.append(Estimated(label, n, i, p.unit, x0, lo, hi, scale))
+        labels = [e.name for e in est]
+        if len(set(labels)) != len(labels):
+            raise ValueError("case ids must be unique when per-case parameters are estimated")
+        fixed = []
+        for e in exps:
+            vals = {n: v for n, v in start.items() if n not in names}
+            vals |= {n: v for n, v in hold.items()}
+            vals |= dict(e.fixed)
+            fixed.append(vals)
+        return cls(model, exps, tuple(est), tuple(fixed), force_cutoff_hz, tuple(notes))
+
+    @property
+    def names(self) -> tuple[str, ...]:
+        """Labels of the estimated parameters, in decision-vector order."""
+        return tuple(e.name for e in self.estimated)
+
+    def case_values(self, i: int, theta: np.ndarray) -> dict[str, float]:
+        """All parameter values of case ``i`` for estimates ``theta`` (unscaled)."""
+        vals = dict(self.fixed[i])
+        for e, v in zip(self.estimated, theta):
+            if e.case is None or e.case == i:
+                vals[e.parameter] = float(v)
+        return vals
+
+    def with_initial(self, values: Mapping[str, float]) -> "FitProblem":
+        """A copy with other initial values for some estimated parameters (by label)."""
+        est = tuple(
+            Estimated(e.name, e.parameter, e.case, e.unit,
+                      min(max(float(values.get(e.name, e.initial)), e.lower), e.upper),
+                      e.lower, e.upper, e.scale)
+            for e in self.estimated)
+        return FitProblem(self.model, self.experiments, est, self.fixed, self.force_cutoff_hz, self.notes)
+
+    @property
+    def initial(self) -> np.ndarray:
+        return np.array([e.initial for e in self.estimated])
+
+    def check(self) -> None:
+        """Raise if an initial value is not finite."""
+        bad = [e.name for e in self.estimated if not math.isfinite(e.initial)]
+        if bad:
+            raise ValueError(f"initial values are not finite: {', '.join(bad)}")

@@ -1,0 +1,224 @@
+"""Fit results: estimates with uncertainties, derived quantities, report and JSON."""
+
+from __future__ import annotations
+
+import math
+from dataclasses import dataclass, field
+from typing import TYPE_CHECKING, Any
+
+import casadi as ca
+import numpy as np
+
+if TYPE_CHECKING:  # pragma: no cover
+    from .identifiability import Identifiability
+    from .problem import FitProblem
+
+__all__ = ["FitResult", "derived_quantities"]
+
+_AUTOCORRELATION_NOTE = (
+    "Standard errors are Gauss-Newton estimates scaled by the residual variance; force "
+    "residuals are autocorrelated, so they are optimistic. Use `profile_interval` for a "
+    "profile-likelihood interval of a chosen parameter.")
+
+
+def _pendulum_names(problem: "FitProblem") -> list[str]:
+    from analogs import Pendulum, SphericalPendulum
+
+    return [c.name for c in problem.model.components if isinstance(c, (Pendulum, SphericalPendulum))]
+
+
+def derived_quantities(problem: "FitProblem", theta: np.ndarray, cov: np.ndarray) -> dict[str, tuple[float, float]]:
+    """``pN.frequency_hz`` and ``pN.damping_ratio`` of each pendulum, with delta-method
+    standard errors: ``omega^2 = g/L + k/(m L^2)``, ``zeta = c / (2 sqrt((m g L + k) m L^2))``
+    with ``k`` and ``c`` the summed hinge and diaphragm stiffness and damping."""
+    th = ca.MX.sym("theta", theta.size)
+    vals: dict[str, Any] = dict(problem.fixed[0])
+    for j, e in enumerate(problem.estimated):
+        if e.case in (None, 0):
+            vals[e.parameter] = th[j]
+    exprs = {}
+    for name in _pendulum_names(problem):
+        m, L, g = vals.get(f"{name}.mass"), vals.get(f"{name}.length"), vals.get("rig.gravity")
+        if m is None or L is None or g is None:
+            continue
+        k = vals.get(f"{name}.stiffness", 0.0) + vals.get(f"{name}.diaphragm_stiffness", 0.0)
+        c = vals.get(f"{name}.damping", 0.0) + vals.get(f"{name}.diaphragm_damping", 0.0)
+        omega = ca.sqrt(g / L + k / (m * L**2))
+        exprs[f"{name}.frequency_hz"] = omega / (2 * math.pi)
+        exprs[f"{name}.damping_ratio"] = c / (2 * ca.sqrt((m * g * L + k) * m * L**2))
+    if not exprs:
+        return {}
+    e = ca.vertcat(*exprs.values())
+    fn = ca.Function("derived", [th], [e, ca.jacobian(e, th)])
+    v, J = fn(theta)
+    v, J = np.asarray(v).ravel(), np.asarray(J)
+    se = np.sqrt(np.clip(np.einsum("ij,jk,ik->i", J, cov, J), 0, None))
+    return {k: (float(a), float(b)) for k, a, b in zip(exprs, v, se)}
+
+
+@dataclass(frozen=True)
+class FitResult:
+    """The outcome of :func:`estimate.fit`.
+
+    ``values``, ``stderr`` and ``covariance`` follow ``names`` (SI units, see ``units``);
+    ``cost`` is the sum of squared force residuals (N^2) at the estimates, ``residuals``
+    and ``measured`` hold, per case, the residual (simulated - measured, N) and the
+    (filtered) measured force; ``history`` the estimates at every IPOPT iteration.
+    """
+
+    problem: "FitProblem" = field(repr=False)
+    values: np.ndarray
+    stderr: np.ndarray
+    covariance: np.ndarray = field(repr=False)
+    cost: float
+    rms_residual: float
+    r_squared: float
+    n_samples: int
+    iterations: int
+    seconds: float
+    converged: bool
+    status: str
+    warnings: tuple[str, ...]
+    identifiability: "Identifiability" = field(repr=False)
+    derived: dict[str, tuple[float, float]]
+    history: np.ndarray = field(repr=False)
+    cost_history: np.ndarray = field(repr=False)
+    residuals: tuple[np.ndarray, ...] = field(repr=False)
+    measured: tuple[np.ndarray, ...] = field(repr=False)
+    cost_kind: str = "squared"
+    transcription: str = ""
+
+    @property
+    def names(self) -> tuple[str, ...]:
+        return self.problem.names
+
+    @property
+    def units(self) -> tuple[str, ...]:
+        return tuple(e.unit for e in self.problem.estimated)
+
+    def value(self, name: str) -> float:
+        """Estimate of ``name`` (a label of :attr:`names`)."""
+        return float(self.values[self._index(name)])
+
+    def _index(self, name: str) -> int:
+        try:
+            return self.names.index(name)
+        except ValueError:
+            raise KeyError(f"{name!r} was not estimated; estimated: {', '.join(self.names)}") from None
+
+    @property
+    def correlation(self) -> np.ndarray:
+        d = np.sqrt(np.diag(self.covariance))
+        with np.errstate(invalid="ignore", divide="ignore"):
+            c = self.covariance / np.outer(d, d)
+        return np.nan_to_num(c)
+
+    def interval(self, name: str, level: float = 0.95) -> tuple[float, float]:
+        """Wald interval from the Gauss-Newton covariance (t distribution)."""
+        from scipy.stats import t as student
+
+        i = self._index(name)
+        q = student.ppf(0.5 + level / 2, max(self.n_samples - len(self.names), 1))
+        return float(self.values[i] - q * self.stderr[i]), float(self.values[i] + q * self.stderr[i])
+
+    @property
+    def case_values(self) -> list[dict[str, float]]:
+        """All model parameter values of every case at the estimates."""
+        return [self.problem.case_values(i, self.values) for i in range(len(self.problem.experiments))]
+
+    def simulated(self, case: int = 0) -> np.ndarray:
+        """Simulated force of ``case`` at the estimates (N)."""
+        return self.measured[case] + self.residuals[case]
+
+    def confounded(self) -> list[str]:
+        """Sentences naming confounded parameter groups and the combination the data fix."""
+        out = []
+        for group, std in zip(self.identifiability.groups, self.identifiability.direction_std):
+            comps = {g.split(":")[-1].split(".")[0] for g in group}
+            text = (f"{' and '.join(f'`{g}`' for g in group)} are confounded: the data fix them only "
+                    f"together (relative std {std:.2g} along their joint direction)")
+            combos = [k for k in self.derived if k.split(".")[0] in comps and k.endswith("frequency_hz")]
+            for k in combos:
+                v, se = self.derived[k]
+                text += f"; the identifiable combination is {k} = {v:.5g} +/- {se:.2g} Hz"
+            out.append(text)
+        return out
+
+    # -- output ------------------------------------------------------------------------------
+    def to_dict(self) -> dict[str, Any]:
+        """The fixed-key JSON form written by ``slosh fit``."""
+        params: dict[str, Any] = {}
+        for name, v, se, e in zip(self.names, self.values, self.stderr, self.problem.estimated):
+            params[name] = {"value": float(v), "stderr": float(se), "unit": e.unit,
+                            "lower": e.lower, "upper": e.upper, "estimated": True}
+        units = {p.name: p.unit for p in self.problem.experiments[0].derived.parameters}
+        needed = set(self.problem.experiments[0].derived.needed_parameters())
+        for name, v in self.problem.fixed[0].items():
+            if name not in params and name in needed and v is not None and math.isfinite(v):
+                params[name] = {"value": float(v), "stderr": None, "unit": units.get(name, ""),
+                                "estimated": False}
+        model = self.problem.model
+        return {
+            "model": model.names,
+            "model_spec": getattr(model, "spec", None) or ",".join(model.names),
+            "cases": [str(e.case.path) for e in self.problem.experiments],
+            "parameters": params,
+            "covariance": {"parameters": list(self.names), "matrix": self.covariance.tolist()},
+            "correlation": self.correlation.tolist(),
+            "derived": {k: v for k, (v, _) in self.derived.items()},
+            "derived_stderr": {k: se for k, (_, se) in self.derived.items()},
+            "cost": self.cost,
+            "rms_residual": self.rms_residual,
+            "r_squared": self.r_squared,
+            "iterations": self.iterations,
+            "seconds": self.seconds,
+            "converged": self.converged,
+            "status": self.status,
+            "confounded": self.confounded(),
+            "warnings": list(self.warnings),
+        }
+
+    def report(self) -> str:
+        """A text fit report: statistics, estimates with intervals, derived quantities,
+        correlations, identifiability, warnings."""
+        lines = ["[[Fit statistics]]",
+                 f"    model              = {' + '.join(self.problem.model.names)}",
+                 f"    cases              = {', '.join(e.case.test.id for e in self.problem.experiments)}",
+                 f"    transcription      = {self.transcription}",
+                 f"    solver status      = {self.status} ({'converged' if self.converged else 'NOT converged'})",
+                 f"    iterations         = {self.iterations}",
+                 f"    wall time          = {self.seconds:.3f} s",
+                 f"    data points        = {self.n_samples}",
+                 f"    variables          = {len(self.names)}",
+                 f"    cost (sum r^2)     = {self.cost:.6g} N^2",
+                 f"    RMS residual       = {self.rms_residual:.6g} N",
+                 f"    R^2                = {self.r_squared:.6f}",
+                 "[[Variables]]"]
+        for name, v, se, e in zip(self.names, self.values, self.stderr, self.problem.estimated):
+            rel = f"({abs(se / v) * 100:.2f}%)" if v else ""
+            lo, hi = self.interval(name)
+            lines.append(f"    {name:28s} = {v:.6g} +/- {se:.3g} {rel:10s} {e.unit:12s} "
+                         f"95%: [{lo:.6g}, {hi:.6g}]  (init {e.initial:.4g})")
+        if self.derived:
+            lines.append("[[Derived]]")
+            for k, (v, se) in self.derived.items():
+                lines.append(f"    {k:28s} = {v:.6g} +/- {se:.3g}")
+        corr = self.correlation
+        pairs = [(abs(corr[i, j]), self.names[i], self.names[j], corr[i, j])
+                 for i in range(len(self.names)) for j in range(i + 1, len(self.names))]
+        pairs = sorted((p for p in pairs if p[0] > 0.1), reverse=True)
+        if pairs:
+            lines.append("[[Correlations]] (|C| > 0.1)")
+            for _, a, b, c in pairs:
+                lines.append(f"    C({a}, {b}) = {c:+.4f}")
+        lines.append("[[Identifiability]]")
+        lines.append(f"    condition number of the scaled sensitivity = {self.identifiability.condition_number:.3g}")
+        conf = self.confounded()
+        lines += [f"    {c}" for c in conf] or ["    every estimated parameter is determined by the data"]
+        lines.append("[[Notes]]")
+        lines.append("    " + _AUTOCORRELATION_NOTE)
+        lines += [f"    {n}" for n in self.problem.notes]
+        if self.warnings:
+            lines.append("[[Warnings]]")
+            lines += [f"    {w}" for w in self.warnings]
+        return "\n".join(lines)
