@@ -17,6 +17,7 @@ from .pendulum import Pendulum, SphericalPendulum
 from .rigs import LateralRig, crank_displacement
 from .rotor import Rotor
 from .suspended_mass import SuspendedMass
+from .vehicle import VehicleFrame
 
 __all__ = [
     "Attachment",
@@ -36,5 +37,6 @@ __all__ = [
     "Rotor",
     "SphericalPendulum",
     "SuspendedMass",
+    "VehicleFrame",
     "crank_displacement",
 ]

@@ -8,11 +8,13 @@ Public API::
 
 from ._derive import derive
 from .derived import OUTPUT_NAMES, OUTPUT_UNITS, DerivedModel, ParameterError
+from .export_c import CExport, export_c
 from .excitation import Excitation, NoExcitation, Sampled, Sine
 from .simulate import RK4, Adaptive, Simulation, rk4_step, simulate
 
 __all__ = [
     "Adaptive",
+    "CExport",
     "DerivedModel",
     "Excitation",
     "NoExcitation",
@@ -24,6 +26,17 @@ __all__ = [
     "Simulation",
     "Sine",
     "derive",
+    "export_c",
+    "export_fmu",
     "rk4_step",
     "simulate",
 ]
+
+
+def export_fmu(*args, **kwargs):  # noqa: D103 - documented in derive.fmu
+    from .fmu import export_fmu as _export_fmu
+
+    return _export_fmu(*args, **kwargs)
+
+
+export_fmu.__doc__ = "Export an FMI 2.0 co-simulation FMU; see :func:`derive.fmu.export_fmu`."
