@@ -58,6 +58,9 @@ def _parser() -> argparse.ArgumentParser:
         prog="slosh", description="Fuel-slosh tank tests to mechanical analog models.")
     sub = parser.add_subparsers(dest="command", required=True)
     _add_simulate(sub)
+    from . import _cli_fit
+
+    _cli_fit.add_parser(sub)
     try:
         from . import _cli_tank
     except ImportError:  # pragma: no cover - the tank module is optional while it is built

@@ -17,7 +17,7 @@ from dataclasses import dataclass
 import casadi as ca
 import numpy as np
 
-from derive import OUTPUT_NAMES, RK4, rk4_step, simulate
+from derive import OUTPUT_NAMES, RK4, simulate
 
 from .identifiability import analyse
 from .problem import FitProblem
@@ -141,7 +141,7 @@ def _measured_force(problem: FitProblem, i: int) -> np.ndarray:
 def fit(problem: FitProblem, *, transcription: Transcription = MultipleShooting(),
         hessian: Hessian = Hessian(), cost: str = "squared", initial_state: str = "rest",
         solver_options: Mapping[str, object] | None = None,
-        progress: bool | None = None) -> FitResult:
+        progress: bool | None = None, robust_start: bool = True) -> FitResult:
     """Estimate the parameters of ``problem``.
 
     Parameters
@@ -161,6 +161,9 @@ def fit(problem: FitProblem, *, transcription: Transcription = MultipleShooting(
         Options passed to ``casadi.nlpsol`` (e.g. ``{"ipopt.max_iter": 500}``).
     progress : bool, optional
         Print iteration and cost live; default: only when stderr is a terminal.
+    robust_start : bool, default True
+        Initialise crank speed corrections from the force spectrum and flywheel angles
+        from a grid over their bounds (:func:`estimate.initial.crank_start`).
 
     Returns
     -------
@@ -176,6 +179,12 @@ def fit(problem: FitProblem, *, transcription: Transcription = MultipleShooting(
         progress = sys.stderr.isatty()
     t_start = time.perf_counter()
     problem.check()
+    if robust_start:
+        from .initial import crank_start
+
+        start = crank_start(problem)
+        if start:
+            problem = problem.with_initial(start)
     est = problem.estimated
     scales = np.array([e.scale for e in est])
     theta_s = ca.MX.sym("theta", len(est))
@@ -216,8 +225,9 @@ def fit(problem: FitProblem, *, transcription: Transcription = MultipleShooting(
     lbx[: len(est)] = [e.lower / e.scale for e in est]
     ubx[: len(est)] = [e.upper / e.scale for e in est]
     opts = dict(_IPOPT_DEFAULTS)
+    Jr = ca.jacobian(r_all, w)
+    residual_fn = ca.Function("residuals", [w], [r_all, Jr])
     if hessian.kind == "gauss-newton":
-        Jr = ca.jacobian(r_all, w)
         sigma = ca.MX.sym("sigma")
         lam = ca.MX.sym("lam", g.numel())
         H = sigma * ca.mtimes(Jr.T, Jr) / norm
@@ -232,48 +242,36 @@ def fit(problem: FitProblem, *, transcription: Transcription = MultipleShooting(
     if progress:
         print(file=sys.stderr)
     stats = solver.stats()
-    theta = np.asarray(sol["x"]).ravel()[: len(est)] * scales
-    seconds_solve = time.perf_counter() - t_start
-    return _result(problem, theta, stats, recorder, measured, cost, seconds_solve, t_start,
-                   transcription)
+    w_opt = np.asarray(sol["x"]).ravel()
+    # IPOPT may leave a bounded variable a hair outside its bound (its bound_relax_factor)
+    theta = np.clip(w_opt[: len(est)] * scales, [e.lower for e in est], [e.upper for e in est])
+    resid, J = _reduced_jacobian(solver, residual_fn, w_opt, len(est), scales)
+    return _result(problem, theta, stats, recorder, measured, resid, J, t_start, transcription, cost)
 
 
-def _rollout_jacobian(problem: FitProblem, theta: np.ndarray, measured: list[np.ndarray]):
-    """Residuals and their Jacobian w.r.t. the (unscaled) estimates, by single-shooting RK4."""
-    th = ca.MX.sym("theta", len(theta))
-    rs = []
-    for i, exp in enumerate(problem.experiments):
-        dm, case = exp.derived, exp.case
-        t = np.asarray(case.time, float)
-        p_i = _parameter_column(dm, problem.fixed[i], th, _unit_scaled(problem), i)
-        out = _measured_output(dm, dm.measured[0]).map(t.size)
-        Ug = exp.excitation.values(t) if dm.nu else np.zeros((0, t.size))
-        if dm.nx:
-            U = MultipleShooting().inputs(exp.excitation, t, dm.nu)
-            horizon = rk4_step(dm, 1).mapaccum(t.size - 1)
-            X = ca.horzcat(ca.DM.zeros(dm.nx), horizon(ca.DM.zeros(dm.nx), ca.DM(U), p_i,
-                                                        ca.DM(t[:-1]).T, ca.DM(np.diff(t)).T))
-        else:
-            X = ca.MX(0, t.size)
-        rs.append(out(X, ca.DM(Ug), p_i, ca.DM(t).T).T - ca.DM(measured[i]))
-    r = ca.vertcat(*rs)
-    fn = ca.Function("rollout", [th], [r, ca.jacobian(r, th)])
-    R, J = fn(theta)
-    return np.asarray(R).ravel(), np.asarray(J)
+def _reduced_jacobian(solver, residual_fn, w_opt: np.ndarray, ntheta: int, scales: np.ndarray):
+    """Residuals and their total derivative w.r.t. the (unscaled) estimates at ``w_opt``.
+
+    The states ``z`` depend on the parameters through the constraints ``g(theta, z) = 0``:
+    ``dz/dtheta = -g_z^-1 g_theta`` and ``dr/dtheta = r_theta + r_z dz/dtheta`` (sparse solve).
+    """
+    import scipy.sparse.linalg as spla
+
+    r, Jr = residual_fn(w_opt)
+    r = np.asarray(r).ravel()
+    Jr = Jr.sparse().tocsc()
+    _, Jg = solver.get_function("nlp_jac_g")(w_opt, [])
+    Jg = Jg.sparse().tocsc()
+    R_theta = Jr[:, :ntheta].toarray()
+    if Jg.shape[0]:
+        dz = -spla.splu(Jg[:, ntheta:].tocsc()).solve(Jg[:, :ntheta].toarray())
+        J = R_theta + Jr[:, ntheta:] @ dz
+    else:
+        J = R_theta
+    return r, np.asarray(J) / scales[None, :]
 
 
-def _unit_scaled(problem: FitProblem) -> FitProblem:
-    from dataclasses import replace
-
-    from .problem import Estimated
-
-    est = tuple(Estimated(e.name, e.parameter, e.case, e.unit, e.initial, e.lower, e.upper, 1.0)
-                for e in problem.estimated)
-    return replace(problem, estimated=est)
-
-
-def _result(problem, theta, stats, recorder, measured, cost, seconds_solve, t_start, transcription):
-    resid, J = _rollout_jacobian(problem, theta, measured)
+def _result(problem, theta, stats, recorder, measured, resid, J, t_start, transcription, cost_kind):
     n, k = resid.size, theta.size
     ssr = float(resid @ resid)
     dof = max(n - k, 1)
@@ -300,7 +298,8 @@ def _result(problem, theta, stats, recorder, measured, cost, seconds_solve, t_st
         warnings.append(f"IPOPT did not converge ({status}): {hint}")
     for e, v in zip(problem.estimated, theta):
         span = e.upper - e.lower
-        if math.isfinite(span) and span > 0 and min(v - e.lower, e.upper - v) < 1e-4 * span:
+        tol = 1e-4 * span if math.isfinite(span) else 1e-5 * e.scale
+        if min(v - e.lower, e.upper - v) < tol:
             warnings.append(f"`{e.name}` = {v:.6g} {e.unit} is at its bound [{e.lower:.6g}, {e.upper:.6g}]")
     F_all = np.concatenate(measured)
     derived = derived_quantities(problem, theta, cov)
@@ -314,5 +313,5 @@ def _result(problem, theta, stats, recorder, measured, cost, seconds_solve, t_st
         warnings=tuple(warnings), identifiability=ident, derived=derived,
         history=np.array(recorder.thetas), cost_history=np.array(recorder.costs),
         residuals=tuple(np.split(resid, np.cumsum([m.size for m in measured])[:-1])),
-        measured=tuple(measured), cost_kind=cost, transcription=repr(transcription),
+        measured=tuple(measured), cost_kind=cost_kind, transcription=repr(transcription),
     )

@@ -23,13 +23,14 @@ class Identifiability:
     """Singular values of the scaled sensitivity, condition number and confounded groups.
 
     ``groups`` lists tuples of parameter names that move together along a weakly
-    determined direction; ``direction_std`` is the relative standard deviation along it.
+    determined direction; ``evidence`` says for each why (relative standard deviation
+    along the direction, or the correlation of a pair).
     """
 
     singular_values: np.ndarray
     condition_number: float
     groups: tuple[tuple[str, ...], ...]
-    direction_std: tuple[float, ...]
+    evidence: tuple[str, ...]
 
     @property
     def identifiable(self) -> bool:
@@ -48,6 +49,7 @@ def analyse(J: np.ndarray, scales: np.ndarray, names: tuple[str, ...], sigma2: f
     Js = J * scales[None, :]
     if Js.size == 0:
         return Identifiability(np.zeros(0), 1.0, (), ())
+    
     _, s, Vt = np.linalg.svd(Js, full_matrices=False)
     smax = s[0] if s.size else 1.0
     cond = float(smax / s[-1]) if s[-1] > 0 else float("inf")
@@ -60,7 +62,7 @@ def analyse(J: np.ndarray, scales: np.ndarray, names: tuple[str, ...], sigma2: f
         members = tuple(names[j] for j in np.argsort(-v) if v[j] >= GROUP_SHARE)
         if len(members) > 1:
             groups.append(members)
-            stds.append(std)
+            stds.append(f"relative standard deviation {std:.2g} along their joint direction")
     if correlation is not None:
         for i in range(len(names)):
             for j in range(i + 1, len(names)):
@@ -68,10 +70,5 @@ def analyse(J: np.ndarray, scales: np.ndarray, names: tuple[str, ...], sigma2: f
                 if abs(correlation[i, j]) > CONFOUNDED_CORRELATION and not any(
                         set(pair) <= set(gr) for gr in groups):
                     groups.append(pair)
-                    v = np.zeros(len(names))
-                    v[i], v[j] = 1.0, -np.sign(correlation[i, j])
-                    v /= np.linalg.norm(v)
-                    proj = Js @ v
-                    nrm = float(np.linalg.norm(proj))
-                    stds.append(float(np.sqrt(sigma2) / nrm) if nrm > 0 else float("inf"))
+                    stds.append(f"correlation {correlation[i, j]:+.4f}")
     return Identifiability(s, cond, tuple(groups), tuple(stds))

@@ -81,3 +81,50 @@ def nominal_scale(name: str, value: float, values: Mapping[str, float], gravity:
     if local in physical:
         return max(abs(value), physical[local])
     return abs(value) if value != 0 else 1.0
+
+
+def crank_start(problem, *, grid: int = 24) -> dict[str, float]:
+    """Robust initial values of the crank nuisance parameters of every crank case.
+
+    The flywheel speed correction comes from the measured force's spectral peak near the
+    nominal drive frequency; the initial flywheel angle from a grid over its bounds,
+    keeping the angle whose simulated force (at the initial parameters, best scaled by a
+    positive factor) is closest to the measurement. Returns values by estimate label.
+    """
+    import numpy as np
+
+    from derive import RK4, simulate
+
+    from .signals import find_spectral_peaks
+
+    out: dict[str, float] = {}
+    for i, exp in enumerate(problem.experiments):
+        case = exp.case
+        if case.test.excitation != "crank" or case.crank is None:
+            continue
+        labels = {e.parameter: e for e in problem.estimated if e.case == i}
+        if not {"rig.omega_correction", "rig.flywheel_angle"} & set(labels):
+            continue
+        f_nom = case.crank.frequency
+        values = problem.case_values(i, problem.initial)
+        if "rig.omega_correction" in labels:
+            e = labels["rig.omega_correction"]
+            peaks = find_spectral_peaks(case.time, case.force, min_frequency=0.85 * f_nom,
+                                        max_frequency=1.15 * f_nom, max_peaks=1)
+            if peaks:
+                dw = 2 * math.pi * (peaks[0].frequency - f_nom)
+                values["rig.omega_correction"] = out[e.name] = min(max(dw, e.lower), e.upper)
+        if "rig.flywheel_angle" in labels:
+            e = labels["rig.flywheel_angle"]
+            F = np.asarray(case.force, float)
+            best = (math.inf, e.initial)
+            for phi in np.linspace(e.lower, e.upper, grid):
+                sim = simulate(exp.derived, {**values, "rig.flywheel_angle": float(phi)}, case.time,
+                               exp.excitation, integrator=RK4(), outputs=exp.derived.measured[:1])
+                S = sim.outputs[:, 0]
+                alpha = max(float(S @ F) / float(S @ S), 0.0) if S @ S > 0 else 0.0
+                cost = float(np.sum((F - alpha * S) ** 2))
+                if cost < best[0]:
+                    best = (cost, float(phi))
+            out[e.name] = best[1]
+    return out

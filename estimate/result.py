@@ -56,6 +56,11 @@ def derived_quantities(problem: "FitProblem", theta: np.ndarray, cov: np.ndarray
     return {k: (float(a), float(b)) for k, a, b in zip(exprs, v, se)}
 
 
+def _json_bound(x: float) -> float | None:
+    """Infinite bounds are written as null (JSON has no infinity)."""
+    return float(x) if math.isfinite(x) else None
+
+
 @dataclass(frozen=True)
 class FitResult:
     """The outcome of :func:`estimate.fit`.
@@ -133,10 +138,10 @@ class FitResult:
     def confounded(self) -> list[str]:
         """Sentences naming confounded parameter groups and the combination the data fix."""
         out = []
-        for group, std in zip(self.identifiability.groups, self.identifiability.direction_std):
+        for group, why in zip(self.identifiability.groups, self.identifiability.evidence):
             comps = {g.split(":")[-1].split(".")[0] for g in group}
             text = (f"{' and '.join(f'`{g}`' for g in group)} are confounded: the data fix them only "
-                    f"together (relative std {std:.2g} along their joint direction)")
+                    f"together ({why})")
             combos = [k for k in self.derived if k.split(".")[0] in comps and k.endswith("frequency_hz")]
             for k in combos:
                 v, se = self.derived[k]
@@ -150,7 +155,8 @@ class FitResult:
         params: dict[str, Any] = {}
         for name, v, se, e in zip(self.names, self.values, self.stderr, self.problem.estimated):
             params[name] = {"value": float(v), "stderr": float(se), "unit": e.unit,
-                            "lower": e.lower, "upper": e.upper, "estimated": True}
+                            "lower": _json_bound(e.lower), "upper": _json_bound(e.upper),
+                            "estimated": True}
         units = {p.name: p.unit for p in self.problem.experiments[0].derived.parameters}
         needed = set(self.problem.experiments[0].derived.needed_parameters())
         for name, v in self.problem.fixed[0].items():
