@@ -166,6 +166,16 @@ class FitProblem:
             for e in self.estimated)
         return FitProblem(self.model, self.experiments, est, self.fixed, self.force_cutoff_hz, self.notes)
 
+    def holding(self, label: str, value: float) -> "FitProblem":
+        """A copy in which the shared estimate ``label`` is held at ``value``."""
+        hit = [e for e in self.estimated if e.name == label]
+        if not hit or hit[0].case is not None:
+            raise KeyError(f"{label!r} is not a shared estimated parameter; estimated: "
+                           + ", ".join(self.names))
+        est = tuple(e for e in self.estimated if e.name != label)
+        fixed = tuple({**f, hit[0].parameter: float(value)} for f in self.fixed)
+        return FitProblem(self.model, self.experiments, est, fixed, self.force_cutoff_hz, self.notes)
+
     @property
     def initial(self) -> np.ndarray:
         return np.array([e.initial for e in self.estimated])

@@ -1,0 +1,58 @@
+"""Test cases written from the independent reference simulator (``reference_models``).
+
+The data are synthetic: hand-written equations integrated by SciPy, never the project's
+own model code.
+"""
+
+from __future__ import annotations
+
+from pathlib import Path
+
+import numpy as np
+
+import reference_models as ref
+from estimate.case import Crank as CrankTable
+from estimate.case import Liquid, Prediction, Rig, Tank, TestInfo, write_case
+
+#: The seed's 8-inch sphere at 60 % fill (Table 8).
+PREDICTION_60 = Prediction(pendulum_mass=1.338, pendulum_length=0.057, fixed_mass=1.456,
+                           damping_ratio=0.00703)
+G = 9.80665
+
+
+def make_case(folder: Path, name: str, excitation, *, pendulums=(), fixed_mass=1.456,
+              dry_mass=1.2, noise=0.01, displacement_noise=2e-5, duration=30.0, rate=100.0,
+              seed=0, prediction: Prediction | None = PREDICTION_60, fill=0.6,
+              diaphragm=False, **effects):
+    """Simulate with ``reference_models.simulate_lateral`` and write ``name.toml``/``.csv``.
+
+    ``excitation`` is a ``reference_models`` excitation; a ``ref.Crank`` writes a crank
+    case without displacement column. Returns ``(case, simulation dict)``.
+    """
+    t = np.arange(int(round(duration * rate)) + 1) / rate
+    crank = isinstance(excitation, ref.Crank)
+    sim = ref.simulate_lateral(t, excitation, pendulums=pendulums, fixed_mass=fixed_mass,
+                               dry_mass=dry_mass, gravity=G, noise=noise,
+                               displacement_noise=0.0 if crank else displacement_noise,
+                               seed=seed, **effects)
+    rig = Rig(dry_mass=dry_mass, gravity=G,
+              crank=CrankTable(excitation.radius, excitation.rod_length, excitation.frequency)
+              if crank else None)
+    case = write_case(
+        Path(folder) / f"{name}.toml",
+        test=TestInfo(id=name, rig="lateral", data=f"{name}.csv",
+                      excitation="crank" if crank else "measured",
+                      note="SYNTHETIC test data from tests/reference_models.py"),
+        tank=Tank(shape="sphere", radius=0.1016, fill_fraction=fill, diaphragm=diaphragm),
+        liquid=Liquid(density=998.2, kinematic_viscosity=1.004e-6),
+        rig=rig, time=t, force=sim["force"],
+        displacement=None if crank else sim["displacement"], prediction=prediction,
+        comment="SYNTHETIC test case (tests/synthetic_cases.py)", overwrite=True)
+    return case, sim
+
+
+def pendulum(mass=1.30, length=0.0553, zeta=0.01, stiffness=0.0, quadratic_damping=0.0):
+    """A reference pendulum with hinge damping from a damping ratio."""
+    return ref.Pendulum(mass, length, stiffness,
+                        ref.hinge_damping(mass, length, zeta, stiffness=stiffness, gravity=G),
+                        quadratic_damping)
