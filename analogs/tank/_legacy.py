@@ -18,8 +18,8 @@ The eigenproblem ``A c = lambda B c`` has ``A_mn = int (U_m,r U_n,r + U_m,z U_n,
 U_m U_n / r^2) r dr dz`` over the liquid's meridian section (the kinetic energy) and
 ``B_mn = int_0^a U_m U_n r dr`` over the free surface (the potential energy). We
 integrate both to convergence with Gauss rules on the exact sphere (the seed's liquid
-masses are the exact sphere's); SLOSH-ML's masked 200 x 200 Simpson rule, or a polygonal
-sphere, move the results by up to one printed digit (polygon: ten), so the table does
+masses are the exact sphere's). SLOSH-ML's masked 200 x 200 Simpson rule moves results
+by up to one printed digit, its 19-segment polygonal sphere by up to 13; the tables do
 not pin the original quadrature beyond "accurate".
 
 The analog quantities are Dodge's: slosh mass ``rho pi lambda a_n^2 / b_n``, length
@@ -127,7 +127,12 @@ def solve(tank: Tank, depth: float, *, n_poly: int = 5, n_bessel: int = 5,
 
     # equilibrate (r^9 spans 1e6 near full), then A c = lambda B c as B c = mu A c
     s = 1.0 / np.sqrt(np.diag(A))
-    mu, vec = eigh(B * np.outer(s, s), A * np.outer(s, s))
+    try:
+        mu, vec = eigh(B * np.outer(s, s), A * np.outer(s, s))
+    except np.linalg.LinAlgError:
+        raise ValueError(f"the legacy basis with `n_poly={n_poly}` is numerically singular "
+                         f"(powers up to r^{2 * n_poly - 1}); the SLOSH code uses "
+                         "`n_poly=5`.") from None
     order = np.argsort(mu)[::-1][:n_modes]
     vec = vec[:, order] * s[:, None]
     lam = 1.0 / mu[order]
