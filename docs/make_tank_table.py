@@ -117,8 +117,9 @@ all 56 numbers of Tables 1 and 8 at once:
    of `J1'`. Reading the first family as the odd solid harmonics `rho^(2n-1) P^1_(2n-1)`
    (the previous version of this mode) misses the 40 % fixed mass (0.477 kg), the 80 %
    first frequency and mass (2.595 Hz, 0.893 kg), the 90 % masses (by 0.012 kg), the 60 %
-   2nd-mode wave ratio (0.410) and every hinge height. The non-harmonic set is legitimate because the method is
-   Rayleigh-Ritz on the energy functional, which needs no harmonic trial functions.
+   2nd-mode wave ratio (0.410) and every hinge height. The non-harmonic set is
+   legitimate: the method is Rayleigh-Ritz on the energy functional, which needs no
+   harmonic trial functions.
 2. **Matrices.** `A_mn = int (U_m,r U_n,r + U_m,z U_n,z + U_m U_n / r^2) r dr dz` over the
    liquid section, `B_mn = int_0^a U_m U_n r dr` over the free surface, `A c = lambda B c`.
 3. **Quadrature and contour.** Converged Gauss rules on the exact sphere reproduce the

@@ -9,15 +9,11 @@ No quadrature, contour or ordering variant we tried moves them down without brea
 others (docs/tank-modes.md).
 """
 
-import os
-
 import pytest
 
 from analogs.tank import Cylinder, Legacy, Liquid, Sphere, predict
 
 from tank_tolerances import TABLE_DAMPING_REL, TABLE_UNIT
-
-os.environ.setdefault("OMP_NUM_THREADS", "1")
 
 R = 0.1016
 WATER = Liquid(998.2, 0.893e-6, "water")
