@@ -13,7 +13,7 @@ from sympy.core.function import AppliedUndef
 from sympy.physics import mechanics as me
 
 from analogs.component import Attachment, Rig
-from analogs.declaration import Declaration, FrameDeclaration, _Collected, _Shared
+from analogs.declaration import Declaration, FrameDeclaration, Namespace, _Collected, _Shared
 from analogs.model import Model
 
 from .derived import OUTPUT_NAMES
@@ -58,12 +58,20 @@ def assemble(model: Model) -> SymbolicModel:
         return {p.local_name: psym[p.name] for p in c.bound_parameters()}
 
     rig = model.rig
-    rig.declare_frame(FrameDeclaration(rig.name, local_params(rig), shared, collected))
+    frame_decl = FrameDeclaration(rig.name, local_params(rig), shared, collected)
+    if rig.coordinates:
+        # A rig that owns generalized coordinates (a free body such as a spacecraft bus)
+        # sees them in declare_frame as `f.q`/`f.qd`, and declares bodies and energies in
+        # declare(k) like a component; the symbols are the same (same names).
+        rig_q = {name: me.dynamicsymbols(f"{rig.prefix}.{name}") for name in rig.coordinates}
+        frame_decl.q = Namespace(rig_q, f"rig {rig.name!r}")
+        frame_decl.qd = Namespace({k: v.diff(t) for k, v in rig_q.items()}, f"rig {rig.name!r}")
+    rig.declare_frame(frame_decl)
 
     coords: list[tuple[str, sp.Function]] = []
     hosts: dict[str, Declaration] = {}
     for c in model.components:
-        if isinstance(c, (Rig, Attachment)):
+        if isinstance(c, Attachment) or (isinstance(c, Rig) and not c.coordinates):
             continue
         qs = {name: me.dynamicsymbols(f"{c.prefix}.{name}") for name in c.coordinates}
         coords += [(f"{c.prefix}.{name}", s) for name, s in qs.items()]
