@@ -141,7 +141,8 @@ def _measured_force(problem: FitProblem, i: int) -> np.ndarray:
 def fit(problem: FitProblem, *, transcription: Transcription = MultipleShooting(),
         hessian: Hessian = Hessian(), cost: str = "squared", initial_state: str = "rest",
         solver_options: Mapping[str, object] | None = None,
-        progress: bool | None = None, robust_start: bool = True) -> FitResult:
+        progress: bool | None = None, robust_start: bool = True,
+        compile_: bool | None = None) -> FitResult:
     """Estimate the parameters of ``problem``.
 
     Parameters
@@ -161,6 +162,10 @@ def fit(problem: FitProblem, *, transcription: Transcription = MultipleShooting(
         Options passed to ``casadi.nlpsol`` (e.g. ``{"ipopt.max_iter": 500}``).
     progress : bool, optional
         Print iteration and cost live; default: only when stderr is a terminal.
+    compile_ : bool, optional
+        Compile the per-interval RK4 value-and-Jacobian function to C (cached on disk by
+        its hash, reused for any case and record length). Default: when a C compiler is
+        available and the Hessian is Gauss-Newton (multiple shooting only).
     robust_start : bool, default True
         Initialise crank speed corrections from the force spectrum and flywheel angles
         from a grid over their bounds (:func:`estimate.initial.crank_start`).
@@ -188,6 +193,13 @@ def fit(problem: FitProblem, *, transcription: Transcription = MultipleShooting(
     est = problem.estimated
     scales = np.array([e.scale for e in est])
     theta_s = ca.MX.sym("theta", len(est))
+    # the exact Hessian differentiates g twice: keep g an AD-able expression then
+    blocks_ok = hessian.kind == "gauss-newton"
+    if compile_ is None:
+        from derive._compile import c_compiler
+
+        compile_ = blocks_ok and c_compiler() is not None
+    blocks = []
     ws, w0s, gs, rs = [theta_s], [problem.initial / scales], [], []
     measured = []
     for i, exp in enumerate(problem.experiments):
@@ -200,7 +212,9 @@ def fit(problem: FitProblem, *, transcription: Transcription = MultipleShooting(
         else:
             guess = np.zeros((0, t.size))
         x0 = np.zeros(dm.nx) if initial_state == "rest" else None
-        block = transcription.block(dm, p_i, t, exp.excitation, guess, x0)
+        block = transcription.block(dm, p_i, t, exp.excitation, guess, x0,
+                                    theta=theta_s if blocks_ok else None, compiled=compile_)
+        blocks.append(block)
         Ug = exp.excitation.values(t) if dm.nu else np.zeros((0, t.size))
         out = _measured_output(dm, dm.measured[0]).map(t.size)
         Y = out(block.X, ca.DM(Ug), p_i, ca.DM(t).T).T
@@ -225,6 +239,14 @@ def fit(problem: FitProblem, *, transcription: Transcription = MultipleShooting(
     lbx[: len(est)] = [e.lower / e.scale for e in est]
     ubx[: len(est)] = [e.upper / e.scale for e in est]
     opts = dict(_IPOPT_DEFAULTS)
+    if blocks_ok and all(b.jac_w is not None or b.g.numel() == 0 for b in blocks):
+        jt = [b.jac_theta for b in blocks if b.g.numel()]
+        jw = [b.jac_w for b in blocks if b.g.numel()]
+        if jt:
+            J = ca.horzcat(ca.vertcat(*jt), ca.diagcat(*jw))
+            g_fast = ca.vertcat(*[b.g_fast for b in blocks if b.g.numel()])
+            opts["jac_g"] = ca.Function("nlp_jac_g", [w, ca.MX(0, 1)], [g_fast, J],
+                                        ["x", "p"], ["g", "jac_g_x"])
     Jr = ca.jacobian(r_all, w)
     residual_fn = ca.Function("residuals", [w], [r_all, Jr])
     if hessian.kind == "gauss-newton":

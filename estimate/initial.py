@@ -38,21 +38,25 @@ def predicted_values(case: Case, model: Model) -> dict[str, float]:
     g = case.rig.gravity
     pendulums = [n for n in model.names if n.startswith("p") and n[1:].isdigit()]
     n_modes = max([int(n[1:]) for n in pendulums] or [1])
-    pred = _tank_prediction(case, max(n_modes, 1))
     out: dict[str, float] = {}
-    modes = {f"p{i + 1}": m for i, m in enumerate(pred.modes)}
-    for name, mode in modes.items():
-        out |= {f"{name}.mass": mode.mass, f"{name}.length": mode.length,
-                f"{name}.hinge_height": mode.hinge_height}
-        zeta = mode.damping_ratio if math.isfinite(mode.damping_ratio) else 0.01
-        out[f"{name}.zeta"] = zeta
-    out |= {"fixed.mass": pred.fixed_mass.mass, "fixed.height": pred.fixed_mass.height,
-            "fixed.inertia": pred.fixed_mass.inertia}
+    # the modal analysis is needed for higher modes or when the case predicts nothing
+    if case.prediction is None or n_modes > 1:
+        pred = _tank_prediction(case, max(n_modes, 1))
+        modes = {f"p{i + 1}": m for i, m in enumerate(pred.modes)}
+        for name, mode in modes.items():
+            out |= {f"{name}.mass": mode.mass, f"{name}.length": mode.length,
+                    f"{name}.hinge_height": mode.hinge_height}
+            zeta = mode.damping_ratio if math.isfinite(mode.damping_ratio) else 0.01
+            out[f"{name}.zeta"] = zeta
+        out |= {"fixed.mass": pred.fixed_mass.mass, "fixed.height": pred.fixed_mass.height,
+                "fixed.inertia": pred.fixed_mass.inertia}
     if case.prediction is not None:
         pr = case.prediction
         out |= {"p1.mass": pr.pendulum_mass, "p1.length": pr.pendulum_length,
                 "fixed.mass": pr.fixed_mass, "p1.zeta": pr.damping_ratio}
     for name in pendulums:
+        if f"{name}.mass" not in out:
+            continue
         m, L = out[f"{name}.mass"], out[f"{name}.length"]
         zeta = out.pop(f"{name}.zeta")
         out[f"{name}.damping"] = 2 * zeta * m * L**2 * math.sqrt(g / L)

@@ -23,12 +23,19 @@ __all__ = ["Transcription", "MultipleShooting", "Collocation", "Block"]
 class Block:
     """One case transcribed: ``w`` its state variables (a column), ``w0`` their initial
     guess, ``g`` the equality constraints (= 0) and ``X`` the states at the samples
-    (``nx x n``), all as functions of ``w`` and the parameter vector."""
+    (``nx x n``), all as functions of ``w`` and the parameter vector.
+
+    ``jac_theta`` and ``jac_w``, when given, are the constraint Jacobian w.r.t. the scaled
+    parameters and ``w``, assembled from per-interval blocks (cheaper than AD of ``g``).
+    """
 
     w: ca.MX
     w0: np.ndarray
     g: ca.MX
     X: ca.MX
+    jac_theta: ca.MX | None = None
+    jac_w: ca.MX | None = None
+    g_fast: ca.MX | None = None
 
 
 class Transcription:
@@ -39,9 +46,12 @@ class Transcription:
         raise NotImplementedError
 
     def block(self, dm: DerivedModel, p: ca.MX, t: np.ndarray, exc: Excitation | None,
-              x_guess: np.ndarray, x0: np.ndarray | None) -> Block:
+              x_guess: np.ndarray, x0: np.ndarray | None, theta: ca.MX | None = None,
+              compiled: bool = False) -> Block:
         """Transcribe one case; ``x_guess`` are states on ``t`` (``nx x n``); ``x0`` fixes
-        the initial state (``None``: free)."""
+        the initial state (``None``: free). With ``theta`` (the scaled decision parameters,
+        of which ``p`` is an affine function), a transcription may also return the
+        constraint Jacobian blocks; ``compiled`` lets it compile per-interval functions."""
         raise NotImplementedError
 
 
@@ -74,15 +84,112 @@ class MultipleShooting(Transcription):
     def inputs(self, exc, t, nu):
         return _interval_inputs(exc, t, np.arange(2 * self.substeps + 1) / (2 * self.substeps), nu)
 
-    def block(self, dm, p, t, exc, x_guess, x0):
+    def block(self, dm, p, t, exc, x_guess, x0, theta=None, compiled=False):
         n = t.size
         W, X, w0 = _states_with_fixed_start(dm.nx, n, x_guess, x0)
         step = rk4_step(dm, self.substeps)
-        U = self.inputs(exc, t, dm.nu)
-        F = step.map(n - 1)
-        xn = F(X[:, :-1], ca.DM(U), p, ca.DM(t[:-1]).T, ca.DM(np.diff(t)).T)
-        g = ca.vec(X[:, 1:] - xn)
-        return Block(ca.vec(W), np.asarray(w0).ravel(order="F"), g, X)
+        U = ca.DM(self.inputs(exc, t, dm.nu))
+        tk, hk = ca.DM(t[:-1]).T, ca.DM(np.diff(t)).T
+        if theta is None or dm.nx == 0:
+            xn = step.map(n - 1)(X[:, :-1], U, p, tk, hk)
+            return Block(ca.vec(W), np.asarray(w0).ravel(order="F"), ca.vec(X[:, 1:] - xn), X)
+        # p = p0 + S theta (affine); per-interval value and Jacobians in one function
+        S = ca.evalf(ca.jacobian(p, theta))
+        p0 = ca.evalf(ca.substitute(p, theta, ca.DM.zeros(theta.numel())))
+        fn = _step_with_jacobians(dm, self.substeps, compiled)
+        xn, JxT, JtT = fn.map(n - 1)(X[:, :-1], U, p0, ca.vec(S), theta, tk, hk)
+        # g stays differentiable by CasADi (interpreted step); the possibly compiled
+        # function only feeds the constraint Jacobian, which IPOPT asks for directly
+        g = ca.vec(X[:, 1:] - step.map(n - 1)(X[:, :-1], U, p, tk, hk))
+        jac_theta = -JtT.T  # rows of interval k stacked: (nx (n-1)) x ntheta
+        jac_w = _bidiagonal(dm.nx, n, -JxT, fixed_start=x0 is not None)
+        return Block(ca.vec(W), np.asarray(w0).ravel(order="F"), g, X, jac_theta, jac_w,
+                     ca.vec(X[:, 1:] - xn))
+
+
+def _step_with_jacobians(dm: DerivedModel, substeps: int, compiled: bool) -> ca.Function:
+    """``(x, U, p0, vec(S), theta, t, h) -> (x_next, (dx_next/dx)^T, (dx_next/dtheta)^T)``
+    with ``p = p0 + S theta``; transposed blocks so that mapped outputs stack by rows."""
+    key = ("rk4_jacobian", substeps, compiled)
+    if key in dm._memo:
+        return dm._memo[key]
+    step = rk4_step(dm, substeps)
+    npar = len(dm.parameter_names)
+    x = ca.SX.sym("x", dm.nx)
+    U = ca.SX.sym("U", step.size1_in(1))
+    p0 = ca.SX.sym("p0", npar)
+    dm._memo[key] = _StepJac(step, x, U, p0, npar, compiled)
+    return dm._memo[key]
+
+
+class _StepJac:
+    """Builds (and caches) the per-interval function for a given number of parameters."""
+
+    def __init__(self, step, x, U, p0, npar, compiled):
+        self.step, self.x, self.U, self.p0, self.npar, self.compiled = step, x, U, p0, npar, compiled
+        self.cache: dict[int, ca.Function] = {}
+
+    def map(self, n: int):
+        def call(X, U, p0, Svec, theta, tk, hk):
+            ntheta = theta.numel()
+            fn = self._function(ntheta)
+            return fn.map(n)(X, U, p0, Svec, theta, tk, hk)
+        return _Caller(call)
+
+    def _function(self, ntheta: int) -> ca.Function:
+        if ntheta not in self.cache:
+            th = ca.SX.sym("theta", ntheta)
+            Sv = ca.SX.sym("S", self.npar * ntheta)
+            t, h = ca.SX.sym("t"), ca.SX.sym("h")
+            p = self.p0 + ca.mtimes(ca.reshape(Sv, self.npar, ntheta), th)
+            xn = self.step(self.x, self.U, p, t, h)
+            fn = ca.Function("rk4_jacobian", [self.x, self.U, self.p0, Sv, th, t, h],
+                             [xn, ca.jacobian(xn, self.x).T, ca.jacobian(xn, th).T])
+            if self.compiled:
+                from derive._compile import compiled as compile_fn
+
+                fn = compile_fn(fn)
+            self.cache[ntheta] = fn
+        return self.cache[ntheta]
+
+
+class _Caller:
+    def __init__(self, fn):
+        self._fn = fn
+
+    def __call__(self, *args):
+        return self._fn(*args)
+
+
+def _bidiagonal(nx: int, n: int, negJ: ca.MX, *, fixed_start: bool) -> ca.MX:
+    """Sparse Jacobian of ``vec(X[:, 1:] - Phi(X[:, :-1]))`` w.r.t. the state variables.
+
+    ``negJ`` holds ``-(dPhi_k/dx)^T`` side by side (``nx x nx (n-1)``). Interval ``k``'s rows
+    have ``I`` at ``X_{k+1}`` and ``-dPhi_k/dx`` at ``X_k`` (absent for a fixed ``X_0``).
+    """
+    offset = -1 if fixed_start else 0  # column block of X_k among the variables
+    nvar = (n - 1 if fixed_start else n) * nx
+    k = np.arange(n - 1)
+    i = np.arange(nx)
+    # identity at X_{k+1}: rows k nx + i, columns (k + 1 + offset) nx + i, constant 1 (src -1)
+    r_id = (k[:, None] * nx + i[None, :]).ravel()
+    c_id = ((k[:, None] + 1 + offset) * nx + i[None, :]).ravel()
+    # -dPhi_k/dx at X_k for k + offset >= 0: entry (i, c) is entry (c, i) of transposed block k
+    kk = k[k + offset >= 0]
+    ii, cc = np.meshgrid(i, i, indexing="ij")
+    r_j = (kk[:, None] * nx + ii.ravel()[None, :]).ravel()
+    c_j = ((kk[:, None] + offset) * nx + cc.ravel()[None, :]).ravel()
+    s_j = (kk[:, None] * nx * nx + (ii * nx + cc).ravel()[None, :]).ravel()
+    rows = np.concatenate([r_id, r_j])
+    cols = np.concatenate([c_id, c_j])
+    src = np.concatenate([np.full(r_id.size, -1), s_j])
+    sp, mapping = ca.Sparsity.triplet((n - 1) * nx, nvar, rows.tolist(), cols.tolist(), True)
+    mapping = np.asarray(mapping, dtype=int)
+    nz_src = np.empty(sp.nnz(), dtype=int)
+    nz_src[mapping] = src
+    values = ca.vertcat(ca.vec(negJ), ca.MX(1.0))  # index -1 -> the constant 1
+    nz_src[nz_src < 0] = values.numel() - 1
+    return ca.MX(sp, values[nz_src.tolist()])
 
 
 @dataclass(frozen=True)
@@ -120,7 +227,7 @@ class Collocation(Transcription):
         tau, _, _ = self._coefficients()
         return _interval_inputs(exc, t, tau[1:], nu)
 
-    def block(self, dm, p, t, exc, x_guess, x0):
+    def block(self, dm, p, t, exc, x_guess, x0, theta=None, compiled=False):
         n, nx, d = t.size, dm.nx, self.degree
         tau, C, D = self._coefficients()
         W, X, w0x = _states_with_fixed_start(nx, n, x_guess, x0)
