@@ -71,6 +71,9 @@ def _parser() -> argparse.ArgumentParser:
 
     _cli_export.add_parser(sub)
     _cli_montecarlo.add_parser(sub)
+    from . import _cli_ntc
+
+    _cli_ntc.add_parser(sub)
     return parser
 
 
