@@ -131,11 +131,17 @@ def _parameter_column(dm, values: Mapping[str, float], theta: ca.MX, problem: Fi
     return ca.vertcat(*entries)
 
 
-def _measured_force(problem: FitProblem, i: int) -> np.ndarray:
+def _measured_force(problem: FitProblem, i: int) -> tuple[np.ndarray, np.ndarray]:
+    """The recorded force as fitted (filtered, measurement models applied) and weights."""
     case = problem.experiments[i].case
-    if problem.force_cutoff_hz is None:
-        return np.asarray(case.force, float)
-    return lowpass(case.time, case.force, cutoff_hz=problem.force_cutoff_hz)
+    F = np.asarray(case.force, float)
+    if problem.force_cutoff_hz is not None:
+        F = lowpass(case.time, F, cutoff_hz=problem.force_cutoff_hz)
+    w = np.ones_like(F) if problem.weights[i] is None else np.asarray(problem.weights[i], float)
+    for mm in problem.measurement:
+        F, wm = mm.measured(case.time, F)
+        w = w * wm
+    return F, w
 
 
 def fit(problem: FitProblem, *, transcription: Transcription = MultipleShooting(),
@@ -201,7 +207,7 @@ def fit(problem: FitProblem, *, transcription: Transcription = MultipleShooting(
         compile_ = blocks_ok and c_compiler() is not None
     blocks = []
     ws, w0s, gs, rs = [theta_s], [problem.initial / scales], [], []
-    measured = []
+    measured, weights = [], []
     for i, exp in enumerate(problem.experiments):
         dm, case = exp.derived, exp.case
         t = np.asarray(case.time, float)
@@ -218,13 +224,22 @@ def fit(problem: FitProblem, *, transcription: Transcription = MultipleShooting(
         Ug = exp.excitation.values(t) if dm.nu else np.zeros((0, t.size))
         out = _measured_output(dm, dm.measured[0]).map(t.size)
         Y = out(block.X, ca.DM(Ug), p_i, ca.DM(t).T).T
-        F = _measured_force(problem, i)
+        F, wts = _measured_force(problem, i)
+        mvals = {e.parameter: theta_s[j] * e.scale for j, e in enumerate(est)
+                 if e.case in (None, i)}
+        for mm in problem.measurement:
+            extra = mm.term(ca.DM(Ug), dm.inputs, mvals)
+            if extra is not None:
+                Y = Y + extra
         measured.append(F)
+        weights.append(wts)
         if cost == "squared":
             r = Y - ca.DM(F)
         else:
             eps = 1e-3 * float(np.std(F))
             r = ca.sqrt(Y**2 + eps**2) - ca.DM(np.abs(F))
+        if np.any(wts != 1.0):
+            r = r * ca.DM(wts)
         ws.append(block.w)
         w0s.append(block.w0)
         gs.append(block.g)
@@ -233,6 +248,7 @@ def fit(problem: FitProblem, *, transcription: Transcription = MultipleShooting(
     g = ca.vertcat(*gs)
     r_all = ca.vertcat(*rs)
     norm = float(np.mean(np.concatenate(measured) ** 2)) or 1.0
+    problem_weights = weights
     f = 0.5 * ca.sumsqr(r_all) / norm
     lbx = np.full(w.numel(), -np.inf)
     ubx = np.full(w.numel(), np.inf)
@@ -268,7 +284,8 @@ def fit(problem: FitProblem, *, transcription: Transcription = MultipleShooting(
     # IPOPT may leave a bounded variable a hair outside its bound (its bound_relax_factor)
     theta = np.clip(w_opt[: len(est)] * scales, [e.lower for e in est], [e.upper for e in est])
     resid, J = _reduced_jacobian(solver, residual_fn, w_opt, len(est), scales)
-    return _result(problem, theta, stats, recorder, measured, resid, J, t_start, transcription, cost)
+    return _result(problem, theta, stats, recorder, measured, resid, J, t_start, transcription, cost,
+                   problem_weights)
 
 
 def _reduced_jacobian(solver, residual_fn, w_opt: np.ndarray, ntheta: int, scales: np.ndarray):
@@ -293,8 +310,10 @@ def _reduced_jacobian(solver, residual_fn, w_opt: np.ndarray, ntheta: int, scale
     return r, np.asarray(J) / scales[None, :]
 
 
-def _result(problem, theta, stats, recorder, measured, resid, J, t_start, transcription, cost_kind):
-    n, k = resid.size, theta.size
+def _result(problem, theta, stats, recorder, measured, resid, J, t_start, transcription, cost_kind,
+            weights):
+    wall = np.concatenate(weights)
+    n, k = int(np.count_nonzero(wall)), theta.size
     ssr = float(resid @ resid)
     dof = max(n - k, 1)
     sigma2 = ssr / dof
@@ -323,7 +342,7 @@ def _result(problem, theta, stats, recorder, measured, resid, J, t_start, transc
         tol = 1e-4 * span if math.isfinite(span) else 1e-5 * e.scale
         if min(v - e.lower, e.upper - v) < tol:
             warnings.append(f"`{e.name}` = {v:.6g} {e.unit} is at its bound [{e.lower:.6g}, {e.upper:.6g}]")
-    F_all = np.concatenate(measured)
+    F_all = np.concatenate(measured)[wall > 0]
     derived = derived_quantities(problem, theta, cov)
     return FitResult(
         problem=problem,
@@ -334,6 +353,8 @@ def _result(problem, theta, stats, recorder, measured, resid, J, t_start, transc
         seconds=time.perf_counter() - t_start, converged=converged, status=status,
         warnings=tuple(warnings), identifiability=ident, derived=derived,
         history=np.array(recorder.thetas), cost_history=np.array(recorder.costs),
-        residuals=tuple(np.split(resid, np.cumsum([m.size for m in measured])[:-1])),
+        residuals=tuple(r / np.where(w > 0, w, 1.0) for r, w in
+                        zip(np.split(resid, np.cumsum([m.size for m in measured])[:-1]), weights)),
+        weights=tuple(weights),
         measured=tuple(measured), cost_kind=cost_kind, transcription=repr(transcription),
     )

@@ -5,7 +5,7 @@ from __future__ import annotations
 
 import math
 from collections.abc import Mapping, Sequence
-from dataclasses import dataclass, field
+from dataclasses import dataclass, field, replace
 
 import numpy as np
 
@@ -51,6 +51,10 @@ class FitProblem:
     fixed: tuple[Mapping[str, float], ...]
     force_cutoff_hz: float | None = 10.0
     notes: tuple[str, ...] = field(default=())
+    #: Per-case sample weights (``None``: all 1); 0 leaves a sample out of the cost.
+    weights: tuple[np.ndarray | None, ...] = field(default=(), repr=False)
+    #: Measurement models (friction, sensor delay) applied to every case.
+    measurement: tuple = field(default=())
 
     @classmethod
     def build(cls, cases: Case | Sequence[Case], model: Model, *,
@@ -58,7 +62,9 @@ class FitProblem:
               hold: Mapping[str, float] | None = None,
               initial: Mapping[str, float] | None = None,
               bounds: Mapping[str, tuple[float, float]] | None = None,
-              force_cutoff_hz: float | None = 10.0) -> "FitProblem":
+              force_cutoff_hz: float | None = 10.0,
+              measurement: Sequence = (),
+              weights: Sequence[np.ndarray | None] | None = None) -> "FitProblem":
         """Set up the estimation of ``model`` on ``cases``.
 
         Parameters
@@ -80,6 +86,11 @@ class FitProblem:
             prediction).
         force_cutoff_hz : float or None, default 10
             Zero-phase low-pass of the measured force before fitting, as the seed did.
+        measurement : sequence of MeasurementModel
+            Friction or sensor delay between the analog and the recording; their
+            parameters are estimated with the others.
+        weights : sequence of arrays, optional
+            Per-case sample weights (0 leaves samples out, e.g. held-out segments).
         """
         cases = (cases,) if isinstance(cases, Case) else tuple(cases)
         if not cases:
@@ -89,6 +100,8 @@ class FitProblem:
         exps = tuple(experiment(c, model) for c in cases)
         dm = exps[0].derived
         params = {p.name: p for p in dm.parameters}
+        for mm in measurement:
+            params |= {n: _as_parameter(n, spec) for n, spec in mm.parameters.items()}
         unknown = sorted((set(hold) | set(initial_user) | set(bounds_user) | set(estimate or ()))
                          - set(params))
         if unknown:
@@ -99,6 +112,7 @@ class FitProblem:
         needed = dm.needed_parameters()
         if estimate is None:
             names = [n for n in needed if n not in rig_fixed and n not in hold]
+            names += [n for mm in measurement for n in mm.parameters if n not in hold]
         else:
             names = list(estimate)
             clash = sorted(set(names) & set(hold))
@@ -142,19 +156,27 @@ class FitProblem:
             vals |= {n: v for n, v in hold.items()}
             vals |= dict(e.fixed)
             fixed.append(vals)
-        return cls(model, exps, tuple(est), tuple(fixed), force_cutoff_hz, tuple(notes))
+        w = tuple(weights) if weights is not None else tuple(None for _ in exps)
+        if len(w) != len(exps):
+            raise ValueError(f"weights: expected one entry per case ({len(exps)}), got {len(w)}")
+        return cls(model, exps, tuple(est), tuple(fixed), force_cutoff_hz, tuple(notes), w,
+                   tuple(measurement))
 
     @property
     def names(self) -> tuple[str, ...]:
         """Labels of the estimated parameters, in decision-vector order."""
         return tuple(e.name for e in self.estimated)
 
-    def case_values(self, i: int, theta: np.ndarray) -> dict[str, float]:
-        """All parameter values of case ``i`` for estimates ``theta`` (unscaled)."""
+    def case_values(self, i: int, theta: np.ndarray, *, model_only: bool = True) -> dict[str, float]:
+        """Parameter values of case ``i`` for estimates ``theta`` (unscaled): the model's
+        (default) or also the measurement models' parameters."""
         vals = dict(self.fixed[i])
         for e, v in zip(self.estimated, theta):
             if e.case is None or e.case == i:
                 vals[e.parameter] = float(v)
+        if model_only:
+            known = set(self.experiments[i].derived.parameter_names)
+            vals = {k: v for k, v in vals.items() if k in known}
         return vals
 
     def with_initial(self, values: Mapping[str, float]) -> "FitProblem":
@@ -164,7 +186,7 @@ class FitProblem:
                       min(max(float(values.get(e.name, e.initial)), e.lower), e.upper),
                       e.lower, e.upper, e.scale)
             for e in self.estimated)
-        return FitProblem(self.model, self.experiments, est, self.fixed, self.force_cutoff_hz, self.notes)
+        return replace(self, estimated=est)
 
     def holding(self, label: str, value: float) -> "FitProblem":
         """A copy in which the shared estimate ``label`` is held at ``value``."""
@@ -174,7 +196,7 @@ class FitProblem:
                            + ", ".join(self.names))
         est = tuple(e for e in self.estimated if e.name != label)
         fixed = tuple({**f, hit[0].parameter: float(value)} for f in self.fixed)
-        return FitProblem(self.model, self.experiments, est, fixed, self.force_cutoff_hz, self.notes)
+        return replace(self, estimated=est, fixed=fixed)
 
     @property
     def initial(self) -> np.ndarray:
@@ -185,3 +207,9 @@ class FitProblem:
         bad = [e.name for e in self.estimated if not math.isfinite(e.initial)]
         if bad:
             raise ValueError(f"initial values are not finite: {', '.join(bad)}")
+
+
+def _as_parameter(name: str, spec):
+    from analogs import Parameter
+
+    return Parameter(name, spec.unit, spec.default, spec.lower, spec.upper, spec.description)

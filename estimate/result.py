@@ -92,6 +92,8 @@ class FitResult:
     measured: tuple[np.ndarray, ...] = field(repr=False)
     cost_kind: str = "squared"
     transcription: str = ""
+    #: Per-case sample weights used (0 = left out of the fit, e.g. held-out segments).
+    weights: tuple[np.ndarray, ...] = field(default=(), repr=False)
 
     @property
     def names(self) -> tuple[str, ...]:
