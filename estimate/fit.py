@@ -208,6 +208,8 @@ def fit(problem: FitProblem, *, transcription: Transcription = MultipleShooting(
     blocks = []
     ws, w0s, gs, rs = [theta_s], [problem.initial / scales], [], []
     measured, weights = [], []
+    extra_cols: list[int] = []
+    raws: list[ca.MX] = []
     for i, exp in enumerate(problem.experiments):
         dm, case = exp.derived, exp.case
         t = np.asarray(case.time, float)
@@ -238,8 +240,12 @@ def fit(problem: FitProblem, *, transcription: Transcription = MultipleShooting(
         else:
             eps = 1e-3 * float(np.std(F))
             r = ca.sqrt(Y**2 + eps**2) - ca.DM(np.abs(F))
+        raws.append(r)
         if np.any(wts != 1.0):
             r = r * ca.DM(wts)
+        if x0 is None:  # the free initial state acts as nx extra parameters
+            offset = sum(int(v.numel()) for v in ws)
+            extra_cols.extend(range(offset, offset + dm.nx))
         ws.append(block.w)
         w0s.append(block.w0)
         gs.append(block.g)
@@ -264,7 +270,7 @@ def fit(problem: FitProblem, *, transcription: Transcription = MultipleShooting(
             opts["jac_g"] = ca.Function("nlp_jac_g", [w, ca.MX(0, 1)], [g_fast, J],
                                         ["x", "p"], ["g", "jac_g_x"])
     Jr = ca.jacobian(r_all, w)
-    residual_fn = ca.Function("residuals", [w], [r_all, Jr])
+    residual_fn = ca.Function("residuals", [w], [r_all, Jr, ca.vertcat(*raws)])
     if hessian.kind == "gauss-newton":
         sigma = ca.MX.sym("sigma")
         lam = ca.MX.sym("lam", g.numel())
@@ -283,37 +289,44 @@ def fit(problem: FitProblem, *, transcription: Transcription = MultipleShooting(
     w_opt = np.asarray(sol["x"]).ravel()
     # IPOPT may leave a bounded variable a hair outside its bound (its bound_relax_factor)
     theta = np.clip(w_opt[: len(est)] * scales, [e.lower for e in est], [e.upper for e in est])
-    resid, J = _reduced_jacobian(solver, residual_fn, w_opt, len(est), scales)
+    resid, J, raw = _reduced_jacobian(solver, residual_fn, w_opt, len(est), scales, extra_cols)
     return _result(problem, theta, stats, recorder, measured, resid, J, t_start, transcription, cost,
-                   problem_weights)
+                   problem_weights, raw)
 
 
-def _reduced_jacobian(solver, residual_fn, w_opt: np.ndarray, ntheta: int, scales: np.ndarray):
+def _reduced_jacobian(solver, residual_fn, w_opt: np.ndarray, ntheta: int, scales: np.ndarray,
+                      extra: list[int] = ()):
     """Residuals and their total derivative w.r.t. the (unscaled) estimates at ``w_opt``.
 
     The states ``z`` depend on the parameters through the constraints ``g(theta, z) = 0``:
     ``dz/dtheta = -g_z^-1 g_theta`` and ``dr/dtheta = r_theta + r_z dz/dtheta`` (sparse solve).
+    Free initial states (columns ``extra``) count as parameters; their columns follow the
+    estimates' in the returned Jacobian.
     """
     import scipy.sparse.linalg as spla
 
-    r, Jr = residual_fn(w_opt)
+    r, Jr, raw = residual_fn(w_opt)
     r = np.asarray(r).ravel()
+    raw = np.asarray(raw).ravel()
     Jr = Jr.sparse().tocsc()
     _, Jg = solver.get_function("nlp_jac_g")(w_opt, [])
     Jg = Jg.sparse().tocsc()
-    R_theta = Jr[:, :ntheta].toarray()
+    pcols = list(range(ntheta)) + list(extra)
+    zcols = np.setdiff1d(np.arange(Jr.shape[1]), pcols)
+    R_p = Jr[:, pcols].toarray()
     if Jg.shape[0]:
-        dz = -spla.splu(Jg[:, ntheta:].tocsc()).solve(Jg[:, :ntheta].toarray())
-        J = R_theta + Jr[:, ntheta:] @ dz
+        dz = -spla.splu(Jg[:, zcols].tocsc()).solve(Jg[:, pcols].toarray())
+        J = R_p + Jr[:, zcols] @ dz
     else:
-        J = R_theta
-    return r, np.asarray(J) / scales[None, :]
+        J = R_p
+    col_scale = np.concatenate([scales, np.ones(len(extra))])
+    return r, np.asarray(J) / col_scale[None, :], raw
 
 
 def _result(problem, theta, stats, recorder, measured, resid, J, t_start, transcription, cost_kind,
-            weights):
+            weights, raw):
     wall = np.concatenate(weights)
-    n, k = int(np.count_nonzero(wall)), theta.size
+    n, k = int(np.count_nonzero(wall)), J.shape[1]
     ssr = float(resid @ resid)
     dof = max(n - k, 1)
     sigma2 = ssr / dof
@@ -326,6 +339,8 @@ def _result(problem, theta, stats, recorder, measured, resid, J, t_start, transc
     except np.linalg.LinAlgError:
         cov = sigma2 * np.linalg.pinv(JtJ)
         warnings.append("the residual sensitivity is singular: covariance from a pseudo-inverse")
+    cov = cov[: theta.size, : theta.size]  # marginal over free initial states
+    J = J[:, : theta.size]
     stderr = np.sqrt(np.clip(np.diag(cov), 0, None))
     scales = np.array([e.scale for e in problem.estimated])
     d = np.sqrt(np.diag(cov))
@@ -353,8 +368,7 @@ def _result(problem, theta, stats, recorder, measured, resid, J, t_start, transc
         seconds=time.perf_counter() - t_start, converged=converged, status=status,
         warnings=tuple(warnings), identifiability=ident, derived=derived,
         history=np.array(recorder.thetas), cost_history=np.array(recorder.costs),
-        residuals=tuple(r / np.where(w > 0, w, 1.0) for r, w in
-                        zip(np.split(resid, np.cumsum([m.size for m in measured])[:-1]), weights)),
+        residuals=tuple(np.split(raw, np.cumsum([m.size for m in measured])[:-1])),
         weights=tuple(weights),
         measured=tuple(measured), cost_kind=cost_kind, transcription=repr(transcription),
     )

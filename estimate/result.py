@@ -66,9 +66,10 @@ class FitResult:
     """The outcome of :func:`estimate.fit`.
 
     ``values``, ``stderr`` and ``covariance`` follow ``names`` (SI units, see ``units``);
-    ``cost`` is the sum of squared force residuals (N^2) at the estimates, ``residuals``
-    and ``measured`` hold, per case, the residual (simulated - measured, N) and the
-    (filtered) measured force; ``history`` the estimates at every IPOPT iteration.
+    ``cost`` is the sum of squared force residuals (N^2) over the fitted samples,
+    ``residuals`` and ``measured`` hold, per case, the residual (simulated - measured, N,
+    also on samples left out by zero weights) and the (filtered) measured force;
+    ``history`` the estimates at every IPOPT iteration.
     """
 
     problem: "FitProblem" = field(repr=False)
