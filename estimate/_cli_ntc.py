@@ -26,6 +26,9 @@ File format (SI units; see ``examples/spacecraft.toml``)::
     hinge_height = 0.1
     damping = 2.0           # pendulums: hinge damping, N m s/rad (optional)
     stiffness = 0.0         # pendulums: hinge stiffness, N m/rad (optional)
+    mount_radius = 0.8      # optional: place this analog off the tank origin (m, rad, m),
+    mount_azimuth = 3.1416  #   in its own frame (`analogs.mounted.Mounted`), e.g. a second
+    mount_height = 0.3      #   tank; mount_axis = "parallel" (default) or "inward"
 
     [ntc]                   # optional
     duration = 2000.0       # s
@@ -43,6 +46,7 @@ from pathlib import Path
 __all__ = ["add_parser", "run", "load_spacecraft"]
 
 _BUS_KEYS = ("spin_rate", "mass", "inertia_x", "inertia_y", "inertia_z")
+_MOUNT_KEYS = {"mount_radius", "mount_azimuth", "mount_height", "mount_axis"}
 _ANALOG_KEYS = {
     "rotor": {"name", "type", "axis", "inertia", "damping"},
     "pendulum": {"name", "type", "plane", "mass", "length", "hinge_height", "damping", "stiffness"},
@@ -81,6 +85,7 @@ def load_spacecraft(path: str | Path):
     Raises ``ValueError`` listing every problem (file, table, key) at once.
     """
     from analogs import FixedMass, HingeDamper, HingeSpring, Pendulum, Rotor, SphericalPendulum
+    from analogs.mounted import Mounted
     from analogs.spacecraft import FreeSpacecraft
 
     path = Path(path)
@@ -129,24 +134,36 @@ def load_spacecraft(path: str | Path):
         if kind not in _ANALOG_KEYS:
             problems.append(f"{where}: `type` must be one of {', '.join(_ANALOG_KEYS)}, got {kind!r}")
             continue
-        for key in sorted(set(a) - _ANALOG_KEYS[kind]):
+        for key in sorted(set(a) - _ANALOG_KEYS[kind] - _MOUNT_KEYS):
             problems.append(f"{where}: unknown key `{key}` for a {kind}")
         if not isinstance(name, str) or not name.isidentifier():
             problems.append(f"{where}: `name` must be an identifier such as \"p1\", got {name!r}")
             continue
+        for key in sorted(set(a) & _MOUNT_KEYS):
+            problems.extend(() if key == "mount_axis" or _number(a, key, where, [], False)
+                            is not None else [f"{where}: `{key}` must be a number"])
+        mount_axis = a.get("mount_axis", "parallel")
+        if mount_axis not in ("parallel", "inward"):
+            problems.append(f"{where}: `mount_axis` must be \"parallel\" or \"inward\", "
+                            f"got {mount_axis!r}")
+            continue
+        mount = {k: float(a[k]) for k in _MOUNT_KEYS - {"mount_axis"} if k in a
+                 and _number(a, k, where, [], False) is not None}
+        wrap = (lambda c: Mounted(c, axis=mount_axis, **mount)) \
+            if (mount or "mount_axis" in a) else (lambda c: c)
         values = {k: _number(a, k, where, problems, required=False)
                   for k in _ANALOG_KEYS[kind] - {"name", "type", "axis", "plane"} if k in a}
         try:
             if kind == "rotor":
-                components.append(Rotor(name, axis=a.get("axis", "z"), **values))
+                components.append(wrap(Rotor(name, axis=a.get("axis", "z"), **values)))
             elif kind == "fixed_mass":
-                components.append(FixedMass(name, **values))
+                components.append(wrap(FixedMass(name, **values)))
             else:
                 hinge = {k: values.pop(k) for k in ("damping", "stiffness") if k in values}
                 if kind == "pendulum":
-                    components.append(Pendulum(name, plane=a.get("plane", "xz"), **values))
+                    components.append(wrap(Pendulum(name, plane=a.get("plane", "xz"), **values)))
                 else:
-                    components.append(SphericalPendulum(name, **values))
+                    components.append(wrap(SphericalPendulum(name, **values)))
                 components.append(HingeDamper(name, damping=hinge.get("damping", 0.0)))
                 if hinge.get("stiffness"):
                     components.append(HingeSpring(name, stiffness=hinge["stiffness"]))

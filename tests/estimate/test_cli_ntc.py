@@ -27,3 +27,19 @@ def test_slosh_ntc_reports_every_problem(tmp_path, capsys):
     for piece in ("`spin_rate` must be a number", "missing `inertia_x`", "unknown key `colour`",
                   "`axis` must be", "`type` must be one of", "problems in the spacecraft file"):
         assert piece in err, piece
+
+
+def test_slosh_ntc_mounts_analogs_off_the_tank_origin(tmp_path, capsys):
+    f = tmp_path / "two.toml"
+    rotor = 'type = "rotor"\naxis = "x"\ninertia = 0.2\ndamping = 0.2\n'
+    f.write_text('[spacecraft]\nspin_rate = 3.0\nmass = 100.0\ninertia_x = 10.0\n'
+                 'inertia_y = 10.0\ninertia_z = 15.0\ntranslation = false\n'
+                 f'[[analog]]\nname = "rx"\n{rotor}'
+                 f'[[analog]]\nname = "ry"\n{rotor}mount_azimuth = 1.5707963267948966\n')
+    assert main(["ntc", str(f)]) == 0
+    text = capsys.readouterr().out
+    assert "Mounted(Rotor('ry'" in text and "Nutation decays" in text
+    f.write_text(f.read_text().replace("mount_azimuth = 1.5707963267948966",
+                                       'mount_axis = "up"'))
+    assert main(["ntc", str(f)]) == 2
+    assert "`mount_axis` must be" in capsys.readouterr().err
