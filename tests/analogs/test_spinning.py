@@ -261,3 +261,19 @@ def test_spinning_rig_parameters_and_channels():
     assert rig.parameter("nutation_frequency").unit == "Hz"
     assert rig.measured == ("force_x", "force_y", "force_z", "torque_x", "torque_y", "torque_z")
     assert SpinningRig(tank_axis="inward").structure() != SpinningRig().structure()
+
+
+def test_suspended_mass_rests_where_the_spring_balances_the_centrifugal_force():
+    from analogs import SuspendedMass
+
+    W, r, m, k = 3.0, 0.5, 2.0, 60.0
+    # radial spring: k s = m W^2 (r + s)  ->  s = m W^2 r / (k - m W^2)
+    s_eq = m * W**2 * r / (k - m * W**2)
+    model = SpinningRig(gravity=False) + SuspendedMass("s1", axes="xy", mass=m, height=0.1,
+                                                       stiffness_x=k, stiffness_y=k)
+    t = np.linspace(0.0, 2.0, 41)
+    sim = simulate(model, {"rig.spin_rate": W, "rig.radius": r, "rig.dry_mass": 0.0}, t,
+                   integrator=Adaptive(rtol=1e-11, atol=1e-13), x0={"s1.s_x": s_eq})
+    assert np.max(np.abs(sim.state("s1.s_x") - s_eq)) < 1e-9
+    assert np.max(np.abs(sim.state("s1.s_y"))) < 1e-9
+    assert sim.output("force_x") == pytest.approx(np.full(t.size, -m * W**2 * (r + s_eq)), rel=1e-9)
