@@ -61,6 +61,9 @@ def _parser() -> argparse.ArgumentParser:
     from . import _cli_fit
 
     _cli_fit.add_parser(sub)
+    from . import _cli_diagnose
+
+    _cli_diagnose.add_parser(sub)
     try:
         from . import _cli_tank
     except ImportError:  # pragma: no cover - the tank module is optional while it is built

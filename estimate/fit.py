@@ -343,7 +343,7 @@ def _result(problem, theta, stats, recorder, measured, resid, J, t_start, transc
     J = J[:, : theta.size]
     stderr = np.sqrt(np.clip(np.diag(cov), 0, None))
     scales = np.array([e.scale for e in problem.estimated])
-    d = np.sqrt(np.diag(cov))
+    d = np.sqrt(np.clip(np.diag(cov), 0, None))
     with np.errstate(invalid="ignore", divide="ignore"):
         corr = np.nan_to_num(cov / np.outer(d, d))
     ident = analyse(J, scales, problem.names, sigma2, corr)
@@ -369,6 +369,7 @@ def _result(problem, theta, stats, recorder, measured, resid, J, t_start, transc
         warnings=tuple(warnings), identifiability=ident, derived=derived,
         history=np.array(recorder.thetas), cost_history=np.array(recorder.costs),
         residuals=tuple(np.split(raw, np.cumsum([m.size for m in measured])[:-1])),
+        sensitivity=J,
         weights=tuple(weights),
         measured=tuple(measured), cost_kind=cost_kind, transcription=repr(transcription),
     )

@@ -95,6 +95,8 @@ class FitResult:
     transcription: str = ""
     #: Per-case sample weights used (0 = left out of the fit, e.g. held-out segments).
     weights: tuple[np.ndarray, ...] = field(default=(), repr=False)
+    #: Sensitivity of the (weighted) residuals to the estimates (samples x parameters).
+    sensitivity: np.ndarray = field(default=None, repr=False)
 
     @property
     def names(self) -> tuple[str, ...]:

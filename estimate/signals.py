@@ -522,7 +522,13 @@ def check_drive_frequency(time: ArrayLike, force: ArrayLike, drive_frequency: fl
 
 
 def _significant_frequencies(t: NDArray[np.float64], x: NDArray[np.float64]) -> list[float]:
-    """Frequencies of displacement components whose *acceleration* is >= 1% of the largest."""
+    """Frequencies of displacement components whose *acceleration* is >= 1% of the largest.
+
+    Spectral peaks cover sines and cranks; for broadband drives (sweeps, steps) the upper
+    edge of the band where the displacement stands 20 dB above the noise floor and its
+    acceleration power is at least 1e-4 of the strongest is added, so a sweep's top
+    frequency is never filtered away.
+    """
     peaks = find_spectral_peaks(t, x, min_frequency=2.0 / (t[-1] - t[0]),
                                 min_relative_height=1e-8, max_peaks=12, refine=False)
     if not peaks:
@@ -530,10 +536,16 @@ def _significant_frequencies(t: NDArray[np.float64], x: NDArray[np.float64]) -> 
                          "cutoff: pass `cutoff_hz` (butterworth) or `window` (savgol)")
     # Noise makes peaks too, and weighting by (2 pi f)^2 favours high-frequency noise: keep
     # only peaks 20 dB above the noise floor (median PSD: the spectrum is mostly floor).
-    floor = float(np.median(welch_spectrum(t, x).psd))
+    spec = welch_spectrum(t, x)
+    floor = float(np.median(spec.psd))
     peaks = tuple(p for p in peaks if p.psd >= _FLOOR_RATIO * floor) or peaks[:1]
     acc = np.array([(2 * np.pi * p.frequency) ** 2 * p.amplitude for p in peaks])
-    return [p.frequency for p, a in zip(peaks, acc) if a >= _SIGNIFICANT * acc.max()]
+    freqs = [p.frequency for p, a in zip(peaks, acc) if a >= _SIGNIFICANT * acc.max()]
+    acc_psd = (2 * np.pi * spec.frequency) ** 4 * spec.psd
+    band = (spec.psd >= _FLOOR_RATIO * floor) & (acc_psd >= _SIGNIFICANT**2 * acc_psd.max())
+    if np.any(band):
+        freqs.append(float(spec.frequency[np.flatnonzero(band)[-1]]))
+    return freqs
 
 
 def _savgol_window(freqs: list[float], step: float, polyorder: int, n: int) -> int:
