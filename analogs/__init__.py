@@ -12,10 +12,13 @@ from .component import Attachment, Component, Rig
 from .fixed_mass import FixedMass
 from .hinge import DiaphragmSpring, HingeDamper, HingeSpring, QuadraticDamper
 from .model import Model, ModelError
+from .mounted import Mounted
 from .parameter import Param, Parameter
 from .pendulum import Pendulum, SphericalPendulum
 from .rigs import LateralRig, crank_displacement
 from .rotor import Rotor
+from .spacecraft import FreeSpacecraft, body_angular_velocity
+from .spinning import SpinningRig
 from .suspended_mass import SuspendedMass
 from .vehicle import VehicleFrame
 
@@ -24,11 +27,13 @@ __all__ = [
     "Component",
     "DiaphragmSpring",
     "FixedMass",
+    "FreeSpacecraft",
     "HingeDamper",
     "HingeSpring",
     "LateralRig",
     "Model",
     "ModelError",
+    "Mounted",
     "Param",
     "Parameter",
     "Pendulum",
@@ -36,7 +41,9 @@ __all__ = [
     "Rig",
     "Rotor",
     "SphericalPendulum",
+    "SpinningRig",
     "SuspendedMass",
     "VehicleFrame",
+    "body_angular_velocity",
     "crank_displacement",
 ]

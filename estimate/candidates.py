@@ -208,7 +208,7 @@ def propose(model: Model, measurement: tuple[MeasurementModel, ...], current: Fi
         out.append(Proposal(
             "diaphragm_stiffness", (f"{p1}:spring",), model + HingeSpring(p1), measurement,
             {f"{p1}.stiffness": k0, f"{p1}.length": Lp},
-            bounds={f"{p1}.length": (0.95 * Lp, 1.05 * Lp)},
+            bounds={f"{p1}.length": (0.99 * Lp, 1.01 * Lp)},
             plausible=plausible_spring, describe=describe_spring))
 
     # -- sensor delay (measurement model, delay profiled) -----------------------------------------

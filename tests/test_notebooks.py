@@ -8,6 +8,7 @@ NOTEBOOKS = sorted((Path(__file__).resolve().parents[1] / "notebooks").glob("*.i
 #: Text each notebook must print: a check that it did its job, not only that it ran.
 EXPECT = {
     "01_fit_lateral_test.ipynb": "identifiable combination is p1.frequency_hz",
+    "02_diagnose.ipynb": "slosh_mode: ",
 }
 
 
