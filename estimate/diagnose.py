@@ -206,15 +206,15 @@ def _profile_delay(fitter: _Fitter, proposal: Proposal, start: dict[str, float],
                                 start, proposal.bounds)
         return cache[tau]
 
-    grid = np.array([0.05, 0.2, 0.4, 0.7]) * (hi - lo) + lo
+    grid = np.array([0.1, 0.3, 0.6]) * (hi - lo) + lo
     costs = [run(tau).cost for tau in grid]
     i = int(np.argmin(costs))
     if costs[i] > 0.99 * reference_cost:  # no delay lowers the cost: not worth refining
         return run(float(grid[i]))
-    step = grid[1] - grid[0]
-    a, b = max(lo, grid[i] - step), min(hi, grid[i] + step)
+    a = lo if i == 0 else grid[i - 1]
+    b = grid[i + 1] if i + 1 < grid.size else hi
     best = minimize_scalar(lambda tau: run(tau).cost, bounds=(a, b), method="bounded",
-                           options={"xatol": 5e-4})
+                           options={"xatol": 1e-3})
     tau = round(float(best.x), 5) if best.fun <= costs[i] else round(float(grid[i]), 5)
     return run(tau)
 
@@ -263,6 +263,11 @@ def diagnose(cases: Case | Sequence[Case], *, min_gain: float = MIN_GAIN,
     weights = [holdout_weights(c.time.size) for c in cases]
     fitter = _Fitter(cases, weights, force_cutoff_hz or force_cutoff(cases))
     base = fitter(model, (), {})
+    if not base.converged:
+        # a lightly damped start next to a resonance can swing over the top: restart damped
+        g = cases[0].rig.gravity
+        m, L = (base.problem.initial[base.names.index(n)] for n in ("p1.mass", "p1.length"))
+        base = fitter(model, (), {"p1.damping": 2 * 0.05 * m * L**2 * math.sqrt(g / L)})
     evidence = collect_evidence(base, segments=segment_damping(base, n_segments=segments))
     fitter.count += segments
     base_evidence = evidence
@@ -318,6 +323,13 @@ def diagnose(cases: Case | Sequence[Case], *, min_gain: float = MIN_GAIN,
                 text = prop.cause
             outcomes.append(CandidateOutcome(prop.cause, prop.added, rms0, rms1, gain, dbic,
                                              reason, text, res))
+        if not any(o.cause == "sensor_delay" for o in outcomes) and not any(
+                isinstance(m, SensorDelay) for m in measurement):
+            outcomes.append(CandidateOutcome(
+                "sensor_delay", ("sensor_delay",), rms0, math.nan, 0.0, 0.0,
+                f"not tried: no timing skew in the residual (correlation with dF/dt "
+                f"{evidence.skew_correlation:+.2f}, implied delay {1e3 * evidence.skew_delay:.1f} ms)",
+                "", current))
         outcomes.sort(key=lambda o: -o.gain)
         rounds.append(tuple(outcomes))
         accepted = [o for o in outcomes if o.rejected is None]
