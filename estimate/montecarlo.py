@@ -11,7 +11,6 @@ executor runs them.
 from __future__ import annotations
 
 import hashlib
-import json
 import math
 import time as _time
 from collections.abc import Mapping, Sequence
@@ -63,13 +62,10 @@ def read_fit(path: str | Path) -> Fit:
         Naming the file and every problem: missing keys, a covariance that is not square,
         names that are not parameters.
     """
+    from .params_io import read_json
+
     path = Path(path)
-    try:
-        data = json.loads(path.read_text())
-    except FileNotFoundError:
-        raise FileNotFoundError(f"fit file {path} does not exist") from None
-    except json.JSONDecodeError as err:
-        raise ValueError(f"{path}: not valid JSON ({err})") from None
+    data = read_json(path, "fit file")
     problems = []
     params = data.get("parameters") if isinstance(data, dict) else None
     if not isinstance(params, dict) or not params:

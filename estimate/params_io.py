@@ -6,7 +6,18 @@ import json
 import math
 from pathlib import Path
 
-__all__ = ["read_params"]
+__all__ = ["read_params", "read_json"]
+
+
+def read_json(path: str | Path, what: str) -> object:
+    """JSON content of ``path``; errors name the file and say what it should be."""
+    path = Path(path)
+    try:
+        return json.loads(path.read_text())
+    except FileNotFoundError:
+        raise FileNotFoundError(f"{what} {path} does not exist") from None
+    except json.JSONDecodeError as err:
+        raise ValueError(f"{path}: not valid JSON ({err})") from None
 
 
 def read_params(path: str | Path) -> dict[str, float]:
@@ -21,12 +32,7 @@ def read_params(path: str | Path) -> dict[str, float]:
         Naming the file and the key when the file is not such JSON.
     """
     path = Path(path)
-    try:
-        data = json.loads(path.read_text())
-    except FileNotFoundError:
-        raise FileNotFoundError(f"parameter file {path} does not exist") from None
-    except json.JSONDecodeError as err:
-        raise ValueError(f"{path}: not valid JSON ({err})") from None
+    data = read_json(path, "parameter file")
     if isinstance(data, dict) and isinstance(data.get("parameters"), dict):
         data = {k: (v.get("value") if isinstance(v, dict) else v) for k, v in data["parameters"].items()}
     if not isinstance(data, dict):
