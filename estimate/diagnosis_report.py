@@ -77,10 +77,12 @@ def summary(d: Diagnosis) -> str:
     if d.rounds:
         lines += ["", "## Candidates", "", "| round | cause | added | held-out gain | BIC change | verdict |",
                   "|---|---|---|---|---|---|"]
+        accepted = {i: f.added for i, f in enumerate(d.findings, 1)}  # round -> what it added
         for i, rnd in enumerate(d.rounds, 1):
             for c in rnd:
+                verdict = "accepted" if accepted.get(i) == c.added else (c.rejected or "smaller gain")
                 lines.append(f"| {i} | {c.cause} | {', '.join(c.added)} | {100 * c.gain:.1f} % | "
-                             f"{c.bic_change:+.0f} | {c.rejected or 'accepted' if c.rejected or (d.findings and c.added == d.findings[min(i, len(d.findings)) - 1].added) else 'not best'} |")
+                             f"{c.bic_change:+.0f} | {verdict} |")
     lines += ["", "## Final parameters", ""] + _parameter_rows(d.final)
     lines += ["", f"{d.candidate_fits} fits in {d.seconds:.1f} s. Held-out RMS: 3 of 10 interleaved "
               "blocks left out of every fit. Standard errors assume independent residuals "
