@@ -37,6 +37,26 @@ CSV file with the measured samples. The format is the one of the estimation issu
 The CSV header is ``time,displacement,force`` (s, m, N); ``displacement`` may be absent when
 ``excitation = "crank"``. Keys not listed above are allowed and ignored (``[test] note`` is kept).
 
+Spinning rig
+------------
+``rig = "spinning"`` describes the Spinning Slosh Test Rig (:class:`analogs.SpinningRig`): the
+rig motion is prescribed by a ``[rig.spin]`` table, so ``[test] excitation`` may be omitted
+(it is then ``"spin"``, the only value accepted for this rig)::
+
+    [rig.spin]
+    rate = 6.0                   # rad/s, table spin rate
+    radius = 0.4                 # m, tank origin from the spin axis
+    nutation_angle = 0.06        # rad, cone half-angle of the table axis
+    nutation_frequency = 0.3     # Hz, coning frequency (either sign)
+    height = 0.3                 # m, optional (default 0): tank origin above the pivot
+    tank_axis = "spin"           # optional: "spin" (default) or "inward"
+    gravity_on = true            # optional (default true): gravity acts
+
+Its CSV has the columns ``time,force_x,force_y,force_z,torque_x,torque_y,torque_z`` (s, N,
+N m; tank-frame components, torques about the mount point), in any order after ``time``;
+extra columns (e.g. measured rig angles) are allowed, kept in :attr:`Case.channels` and
+checked like the others.
+
 :func:`load_case` validates everything and raises one :class:`CaseError` listing every problem;
 input files are never modified. :func:`write_case` writes a case (TOML + CSV), e.g. for
 generated data, and refuses to overwrite existing files unless asked to.
@@ -80,16 +100,24 @@ __all__ = [
     "Liquid",
     "Prediction",
     "Rig",
+    "SPINNING_CHANNELS",
+    "Spin",
     "Tank",
     "TestInfo",
     "load_case",
     "write_case",
 ]
 
-KNOWN_RIGS: tuple[str, ...] = ("lateral",)
-"""Values accepted for ``[test] rig`` (``"spinning"`` is planned, not supported yet)."""
-KNOWN_EXCITATIONS: tuple[str, ...] = ("measured", "crank")
-"""Values accepted for ``[test] excitation``."""
+KNOWN_RIGS: tuple[str, ...] = ("lateral", "spinning")
+"""Values accepted for ``[test] rig``."""
+KNOWN_EXCITATIONS: tuple[str, ...] = ("measured", "crank", "spin")
+"""Values accepted for ``[test] excitation`` (``"spin"``: only, and by default, for the
+spinning rig)."""
+SPINNING_CHANNELS: tuple[str, ...] = ("force_x", "force_y", "force_z",
+                                      "torque_x", "torque_y", "torque_z")
+"""Columns a spinning-rig CSV must have besides ``time`` (N and N m)."""
+TANK_AXES: tuple[str, ...] = ("spin", "inward")
+"""Values accepted for ``[rig.spin] tank_axis``."""
 KNOWN_SHAPES: tuple[str, ...] = ("sphere", "cylinder")
 """Values accepted for ``[tank] shape``."""
 MIN_SAMPLES: int = 50
@@ -213,6 +241,38 @@ class Crank:
 
 
 @dataclass(frozen=True)
+class Spin:
+    """The ``[rig.spin]`` table: prescribed motion of the spinning rig
+    (:class:`analogs.SpinningRig`).
+
+    Attributes
+    ----------
+    rate : float
+        Table spin rate [rad/s].
+    radius : float
+        Distance of the tank origin (mount point) from the spin axis [m], >= 0.
+    nutation_angle : float
+        Half-angle of the cone swept by the table axis [rad], in [0, pi/2).
+    nutation_frequency : float
+        Coning frequency of the table axis [Hz] (positive: with the spin).
+    height : float, default 0
+        Height of the tank origin above the nutation pivot along the spin axis [m].
+    tank_axis : str, default "spin"
+        ``"spin"`` or ``"inward"`` (see :class:`analogs.SpinningRig`).
+    gravity_on : bool, default True
+        Whether gravity acts (``[rig] gravity`` gives its value).
+    """
+
+    rate: float
+    radius: float
+    nutation_angle: float
+    nutation_frequency: float
+    height: float = 0.0
+    tank_axis: str = "spin"
+    gravity_on: bool = True
+
+
+@dataclass(frozen=True)
 class Rig:
     """The ``[rig]`` table.
 
@@ -224,11 +284,14 @@ class Rig:
         Gravitational acceleration [m/s^2].
     crank : Crank or None
         The ``[rig.crank]`` table when present.
+    spin : Spin or None
+        The ``[rig.spin]`` table (spinning rig only).
     """
 
     dry_mass: float
     gravity: float
     crank: Crank | None = None
+    spin: Spin | None = None
 
 
 @dataclass(frozen=True)
@@ -271,8 +334,11 @@ class Case:
         Sample times [s], strictly increasing and uniform.
     displacement : numpy.ndarray or None
         Carriage displacement [m]; None when the CSV has no displacement column.
-    force : numpy.ndarray
-        Measured lateral force [N].
+    force : numpy.ndarray or None
+        Measured lateral force [N] (lateral rig); None for the spinning rig.
+    columns : mapping of str to numpy.ndarray
+        The CSV columns besides ``time`` of a spinning-rig case (empty for a lateral case);
+        read them through :attr:`channels`.
     """
 
     path: Path
@@ -284,7 +350,21 @@ class Case:
     prediction: Prediction | None
     time: NDArray[np.float64] = field(repr=False)
     displacement: NDArray[np.float64] | None = field(repr=False)
-    force: NDArray[np.float64] = field(repr=False)
+    force: NDArray[np.float64] | None = field(repr=False)
+    columns: Mapping[str, NDArray[np.float64]] = field(default_factory=dict, repr=False)
+
+    @property
+    def channels(self) -> dict[str, NDArray[np.float64]]:
+        """Measured signals by output name: ``{"force_x": force}`` for the lateral rig, the
+        six force/torque channels (and any extra CSV columns) for the spinning rig."""
+        if self.test.rig == "lateral":
+            return {} if self.force is None else {"force_x": self.force}
+        return dict(self.columns)
+
+    @property
+    def spin(self) -> Spin | None:
+        """The ``[rig.spin]`` table, or None."""
+        return self.rig.spin
 
     @property
     def crank(self) -> Crank | None:
@@ -404,7 +484,12 @@ def _read_test(ck: _Checker, doc: Mapping[str, Any]) -> TestInfo | None:
     test_id = ck.string(t, "test", "id")
     rig = ck.string(t, "test", "rig", choices=KNOWN_RIGS)
     data = ck.string(t, "test", "data")
-    excitation = ck.string(t, "test", "excitation", choices=KNOWN_EXCITATIONS)
+    spinning = rig == "spinning"
+    excitation = ck.string(t, "test", "excitation",
+                           choices=("spin",) if spinning else ("measured", "crank"),
+                           required=not spinning)
+    if spinning and "excitation" not in t:
+        excitation = "spin"  # the spinning rig's motion comes from `[rig.spin]`
     note = ck.string(t, "test", "note", required=False)
     if data is not None and not data.strip():
         ck.add("[test] data", 'expected a CSV path, found an empty string ""')
@@ -464,18 +549,54 @@ def _read_crank(ck: _Checker, doc: Mapping[str, Any], *, required: bool) -> tupl
     return True, Crank(radius=radius, rod_length=rod, frequency=freq)
 
 
-def _read_rig(ck: _Checker, doc: Mapping[str, Any], excitation: str | None) -> Rig | None:
+def _read_spin(ck: _Checker, doc: Mapping[str, Any], *, required: bool) -> tuple[bool, Spin | None]:
+    """Return (table present, spin or None)."""
+    rig = doc.get("rig")
+    present = isinstance(rig, Mapping) and "spin" in rig
+    if not present:
+        if required:
+            ck.add("[rig.spin]", 'missing table (expected `[rig.spin]` with rate, radius, '
+                   'nutation_angle and nutation_frequency because `[test] rig = "spinning"`)')
+        return False, None
+    t = ck.table(doc, "rig.spin", required=True)
+    if t is None:
+        return True, None
+    rate = ck.number(t, "rig.spin", "rate", unit="rad/s")
+    radius = ck.number(t, "rig.spin", "radius", unit="m", nonnegative=True)
+    angle = ck.number(t, "rig.spin", "nutation_angle", unit="rad", nonnegative=True)
+    if angle is not None and not angle < math.pi / 2:
+        ck.add("[rig.spin] nutation_angle",
+               f"expected a cone half-angle below pi/2 rad, found {angle!r} rad")
+        angle = None
+    freq = ck.number(t, "rig.spin", "nutation_frequency", unit="Hz")
+    height = ck.number(t, "rig.spin", "height", unit="m") if "height" in t else 0.0
+    axis = ck.string(t, "rig.spin", "tank_axis", choices=TANK_AXES, required=False)
+    gravity_on = ck.boolean(t, "rig.spin", "gravity_on") if "gravity_on" in t else True
+    if None in (rate, radius, angle, freq, height, gravity_on) or ("tank_axis" in t and axis is None):
+        return True, None
+    assert rate is not None and radius is not None and angle is not None and freq is not None
+    assert height is not None and gravity_on is not None
+    return True, Spin(rate=rate, radius=radius, nutation_angle=angle, nutation_frequency=freq,
+                      height=height, tank_axis=axis or "spin", gravity_on=gravity_on)
+
+
+def _read_rig(ck: _Checker, doc: Mapping[str, Any], excitation: str | None,
+              rig_kind: str | None = None) -> Rig | None:
     t = ck.table(doc, "rig", required=True)
     dry = grav = None
     if t is not None:
         dry = ck.number(t, "rig", "dry_mass", unit="kg", positive=True)
         grav = ck.number(t, "rig", "gravity", unit="m/s^2", positive=True)
     present, crank = _read_crank(ck, doc, required=(excitation == "crank" and t is not None))
+    spinning = rig_kind == "spinning"
+    spin_present, spin = _read_spin(ck, doc, required=spinning and t is not None)
     if dry is None or grav is None or (present and crank is None):
         return None
     if excitation == "crank" and crank is None:
         return None
-    return Rig(dry_mass=dry, gravity=grav, crank=crank)
+    if spin_present and spin is None or (spinning and spin is None):
+        return None
+    return Rig(dry_mass=dry, gravity=grav, crank=crank, spin=spin if spinning else None)
 
 
 def _read_prediction(ck: _Checker, doc: Mapping[str, Any]) -> tuple[bool, Prediction | None]:
@@ -505,10 +626,10 @@ def _rows_text(lines: list[int]) -> str:
     return f"line{'s' if len(lines) != 1 else ''} {shown}{more}"
 
 
-def _read_csv(path: Path, excitation: str | None,
-              problems: list[str]) -> tuple[NDArray[np.float64], NDArray[np.float64] | None,
-                                            NDArray[np.float64]] | None:
-    """Read and check the CSV; append problems; return (time, displacement, force) or None."""
+def _read_csv(path: Path, excitation: str | None, problems: list[str],
+              rig_kind: str | None = "lateral") -> tuple[Any, ...] | None:
+    """Read and check the CSV; append problems; return (time, displacement, force, columns)
+    or None (``columns``: the non-time columns of a spinning-rig CSV, else empty)."""
     name = path.name
     try:
         with path.open("r", newline="", encoding="utf-8") as fh:
@@ -521,12 +642,32 @@ def _read_csv(path: Path, excitation: str | None,
         problems.append(f"{name}: not a readable UTF-8 CSV file ({exc})")
         return None
     rows = [(n, r) for n, r in rows if r and any(c.strip() for c in r)]  # skip blank lines
+    spinning = rig_kind == "spinning"
+    spin_header = "`" + ",".join(("time",) + SPINNING_CHANNELS) + "`"
     if not rows:
-        problems.append(f"{name}: header: expected `time,displacement,force`, found an empty file")
+        expected = spin_header if spinning else "`time,displacement,force`"
+        problems.append(f"{name}: header: expected {expected}, found an empty file")
         return None
     header_line, header = rows[0]
     names = tuple(c.strip() for c in header)
-    if names == _COLUMNS_FULL:
+    has_disp = False
+    if spinning:
+        missing = [c for c in SPINNING_CHANNELS if c not in names]
+        repeated = sorted({c for c in names if names.count(c) > 1})
+        if not names or names[0] != "time" or missing or repeated:
+            found = []
+            if not names or names[0] != "time":
+                found.append(f"first column `{names[0] if names else ''}` instead of `time`")
+            if missing:
+                found.append("no column" + ("s " if len(missing) > 1 else " ")
+                             + ", ".join(f"`{c}`" for c in missing))
+            if repeated:
+                found.append("repeated column(s) " + ", ".join(f"`{c}`" for c in repeated))
+            problems.append(f"{name}: header (line {header_line}): expected {spin_header} "
+                            f"(extra columns allowed) for `rig = \"spinning\"`, found "
+                            f"`{','.join(header)}` ({'; '.join(found)})")
+            return None
+    elif names == _COLUMNS_FULL:
         has_disp = True
     elif names == _COLUMNS_CRANK:
         has_disp = False
@@ -537,7 +678,7 @@ def _read_csv(path: Path, excitation: str | None,
         problems.append(f"{name}: header (line {header_line}): expected {expected}, "
                         f"found `{','.join(header)}`")
         return None
-    if not has_disp and excitation != "crank":
+    if not spinning and not has_disp and excitation != "crank":
         problems.append(
             f"{name}: column `displacement`: missing, but `[test] excitation = \"measured\"` "
             "needs the carriage displacement (expected header `time,displacement,force`; "
@@ -606,9 +747,12 @@ def _read_csv(path: Path, excitation: str | None,
                     f"{lines[worst + 1]})")
     if len(problems) > 0:
         return None
+    if spinning:
+        columns = {c: data[:, j].copy() for j, c in enumerate(names) if j > 0}
+        return t.copy(), None, None, columns
     force = data[:, -1].copy()
     disp = data[:, 1].copy() if has_disp else None
-    return t.copy(), disp, force
+    return t.copy(), disp, force, {}
 
 
 # ----------------------------------------------------------------------------------------------
@@ -664,9 +808,11 @@ def load_case(path: str | os.PathLike[str]) -> Case:
     t_table = doc.get("test")
     if isinstance(t_table, Mapping) and t_table.get("excitation") in KNOWN_EXCITATIONS:
         excitation = t_table["excitation"]
+    rig_kind = t_table.get("rig") if isinstance(t_table, Mapping) else None
+    rig_kind = rig_kind if rig_kind in KNOWN_RIGS else None
     tank = _read_tank(ck, doc)
     liquid = _read_liquid(ck, doc)
-    rig = _read_rig(ck, doc, excitation)
+    rig = _read_rig(ck, doc, excitation, rig_kind)
     pred_present, prediction = _read_prediction(ck, doc)
 
     problems = ck.problems
@@ -682,7 +828,7 @@ def load_case(path: str | os.PathLike[str]) -> Case:
                             f"at `{data_path}`)")
         else:
             csv_problems: list[str] = []
-            arrays = _read_csv(data_path, excitation, csv_problems)
+            arrays = _read_csv(data_path, excitation, csv_problems, rig_kind)
             problems.extend(csv_problems)
 
     if problems:
@@ -690,13 +836,13 @@ def load_case(path: str | os.PathLike[str]) -> Case:
     assert test is not None and tank is not None and liquid is not None and rig is not None
     assert arrays is not None and data_path is not None
     assert not (pred_present and prediction is None)
-    time, disp, force = arrays
-    for arr in (time, disp, force):
+    time, disp, force, columns = arrays
+    for arr in (time, disp, force, *columns.values()):
         if arr is not None:
             arr.flags.writeable = False
     return Case(path=toml_path.resolve(), data_path=data_path.resolve(), test=test, tank=tank,
                 liquid=liquid, rig=rig, prediction=prediction, time=time, displacement=disp,
-                force=force)
+                force=force, columns=columns)
 
 
 def _toml_value(value: Any) -> str:
@@ -745,6 +891,15 @@ def _toml_text(test: TestInfo, tank: Tank, liquid: Liquid, rig: Rig,
                      ("kinematic_viscosity", liquid.kinematic_viscosity, "m^2/s")])
     table("rig", [("dry_mass", rig.dry_mass, "kg moving with the tank, seen by the transducer"),
                   ("gravity", rig.gravity, "m/s^2")])
+    if rig.spin is not None:
+        sp = rig.spin
+        table("rig.spin", [("rate", sp.rate, "rad/s, table spin rate"),
+                           ("radius", sp.radius, "m, tank origin from the spin axis"),
+                           ("nutation_angle", sp.nutation_angle, "rad, cone half-angle"),
+                           ("nutation_frequency", sp.nutation_frequency, "Hz, coning frequency"),
+                           ("height", sp.height, "m, tank origin above the nutation pivot"),
+                           ("tank_axis", sp.tank_axis, ""),
+                           ("gravity_on", sp.gravity_on, "")])
     if rig.crank is not None:
         table("rig.crank", [("radius", rig.crank.radius, "m"),
                             ("rod_length", rig.crank.rod_length, "m"),
@@ -758,10 +913,16 @@ def _toml_text(test: TestInfo, tank: Tank, liquid: Liquid, rig: Rig,
 
 
 def _csv_text(time: NDArray[np.float64], displacement: NDArray[np.float64] | None,
-              force: NDArray[np.float64]) -> str:
-    cols = [time] if displacement is None else [time, displacement]
-    cols.append(force)
-    header = "time,force" if displacement is None else "time,displacement,force"
+              force: NDArray[np.float64] | None,
+              channels: Mapping[str, NDArray[np.float64]] | None = None) -> str:
+    if channels is not None:
+        cols = [time, *channels.values()]
+        header = ",".join(["time", *channels])
+    else:
+        assert force is not None
+        cols = [time] if displacement is None else [time, displacement]
+        cols.append(force)
+        header = "time,force" if displacement is None else "time,displacement,force"
     body = np.column_stack(cols)
     lines = [header]
     lines.extend(",".join(format(float(v), ".12g") for v in row) for row in body)
@@ -769,8 +930,9 @@ def _csv_text(time: NDArray[np.float64], displacement: NDArray[np.float64] | Non
 
 
 def write_case(path: str | os.PathLike[str], *, test: TestInfo, tank: Tank, liquid: Liquid,
-               rig: Rig, time: ArrayLike, force: ArrayLike,
+               rig: Rig, time: ArrayLike, force: ArrayLike | None = None,
                displacement: ArrayLike | None = None, prediction: Prediction | None = None,
+               channels: Mapping[str, ArrayLike] | None = None,
                comment: str = "", overwrite: bool = False) -> Case:
     """Write a case file (TOML) and its CSV, then load them back.
 
@@ -786,11 +948,14 @@ def write_case(path: str | os.PathLike[str], *, test: TestInfo, tank: Tank, liqu
         The tables to write (``prediction`` optional).
     time : array_like
         Sample times [s].
-    force : array_like
-        Lateral force [N].
+    force : array_like, optional
+        Lateral force [N] (lateral rig; required there).
     displacement : array_like, optional
         Carriage displacement [m]; omit for ``excitation = "crank"`` without a measured
         displacement.
+    channels : mapping of str to array_like, optional
+        Spinning rig (required there): the six channels of :data:`SPINNING_CHANNELS`
+        (N, N m) and any extra columns, written in this order after ``time``.
     comment : str, optional
         Text written as ``#`` comment lines at the top of the TOML file.
     overwrite : bool, default False
@@ -831,14 +996,29 @@ def write_case(path: str | os.PathLike[str], *, test: TestInfo, tank: Tank, liqu
             raise FileExistsError(f"refusing to overwrite existing file(s) {', '.join(existing)}; "
                                   "pass `overwrite=True` to replace them")
     t = np.asarray(time, dtype=float)
-    f = np.asarray(force, dtype=float)
-    d = None if displacement is None else np.asarray(displacement, dtype=float)
-    if t.ndim != 1 or f.shape != t.shape or (d is not None and d.shape != t.shape):
-        raise ValueError(f"expected 1-D `time`, `force` (and `displacement`) of equal length, "
-                         f"found shapes {t.shape}, {f.shape}"
-                         + ("" if d is None else f", {d.shape}"))
-    toml_text = _toml_text(test, tank, liquid, rig, prediction, comment)
-    csv_text = _csv_text(t, d, f)
+    if test.rig == "spinning":
+        if channels is None or force is not None or displacement is not None:
+            raise ValueError("a spinning-rig case takes `channels` (time series of "
+                             + ", ".join(SPINNING_CHANNELS) + "), not `force` or `displacement`")
+        ch = {str(k): np.asarray(v, dtype=float) for k, v in channels.items()}
+        bad = {k: v.shape for k, v in ch.items() if v.shape != t.shape}
+        if t.ndim != 1 or bad:
+            raise ValueError(f"expected 1-D `time` and channels of its length {t.shape}, found "
+                             + ", ".join(f"`{k}` {v}" for k, v in bad.items()))
+        toml_text = _toml_text(test, tank, liquid, rig, prediction, comment)
+        csv_text = _csv_text(t, None, None, ch)
+    else:
+        if force is None or channels is not None:
+            raise ValueError("a lateral-rig case takes `force` (and `displacement`), "
+                             "not `channels`")
+        f = np.asarray(force, dtype=float)
+        d = None if displacement is None else np.asarray(displacement, dtype=float)
+        if t.ndim != 1 or f.shape != t.shape or (d is not None and d.shape != t.shape):
+            raise ValueError(f"expected 1-D `time`, `force` (and `displacement`) of equal "
+                             f"length, found shapes {t.shape}, {f.shape}"
+                             + ("" if d is None else f", {d.shape}"))
+        toml_text = _toml_text(test, tank, liquid, rig, prediction, comment)
+        csv_text = _csv_text(t, d, f)
 
     toml_path.parent.mkdir(parents=True, exist_ok=True)
     with tempfile.TemporaryDirectory(dir=toml_path.parent, prefix=".case-") as tmp:

@@ -140,8 +140,17 @@ def baseline_model(case: Case) -> Model:
 
     A free liquid surface has no restoring stiffness besides gravity; a hinge spring is
     what a diaphragm adds, so it is a candidate (``diaphragm_stiffness``), not part of the
-    baseline. The pendulum length is anchored to the prediction (+/-20 %).
+    baseline. The pendulum length is anchored to the prediction (+/-20 %). On the spinning
+    rig the pendulum is spherical (:class:`analogs.SphericalPendulum`) on the rig of
+    :func:`estimate.models.rig_for`.
     """
+    if case.test.rig == "spinning":
+        from analogs import SphericalPendulum
+
+        from .models import rig_for
+
+        return (Model((rig_for(case),)) + FixedMass("fixed") + SphericalPendulum("p1")
+                + HingeDamper("p1"))
     return (LateralRig(excitation=case.test.excitation) + FixedMass("fixed") + Pendulum("p1")
             + HingeDamper("p1"))
 
@@ -156,8 +165,9 @@ def holdout_weights(n: int, *, blocks: int = 10, held: Sequence[int] = (1, 4, 7)
 
 
 def _heldout_rms(res: FitResult) -> float:
-    num = sum(float(np.sum(r[w == 0] ** 2)) for r, w in zip(res.residuals, res.weights))
-    cnt = sum(int(np.sum(w == 0)) for w in res.weights)
+    num = sum(float(np.sum(res.scaled_residuals(i)[w == 0] ** 2)) for i, w in enumerate(res.weights))
+    cnt = sum(int(np.sum(w == 0)) * (len(res.channels[i]) if res.channels else 1)
+              for i, w in enumerate(res.weights))
     return math.sqrt(num / cnt) if cnt else res.rms_residual
 
 
@@ -173,6 +183,7 @@ def _start_values(current: FitResult, proposal: Proposal) -> dict[str, float]:
 
 
 _CANDIDATE_SOLVER = {"ipopt.max_iter": 80, "ipopt.max_cpu_time": 20.0}
+_SPINNING_SOLVER = {"ipopt.max_iter": 150, "ipopt.max_cpu_time": 120.0}
 
 
 class _Fitter:
@@ -190,8 +201,11 @@ class _Fitter:
                                 bounds=bounds, force_cutoff_hz=self.cutoff)
         known = set(e.name for e in prob.estimated)
         prob = prob.with_initial({k: v for k, v in initial.items() if k in known})
-        # candidates that do not converge quickly are not what the data want
-        return fit(prob, progress=False, solver_options=_CANDIDATE_SOLVER)
+        # candidates that do not converge quickly are not what the data want; six-channel
+        # spinning-rig fits have six times the residuals and start farther (no input)
+        opts = _CANDIDATE_SOLVER if all(len(e.channels) == 1 for e in prob.experiments) \
+            else _SPINNING_SOLVER
+        return fit(prob, progress=False, solver_options=opts)
 
 
 def _profile_delay(fitter: _Fitter, proposal: Proposal, start: dict[str, float],
@@ -229,7 +243,9 @@ def force_cutoff(cases: Sequence[Case]) -> float:
     tops = []
     for c in cases:
         fs = 1.0 / float(np.median(np.diff(c.time)))
-        if c.displacement is not None:
+        if c.spin is not None:
+            top = abs(c.spin.rate) / (2 * math.pi)
+        elif c.displacement is not None:
             top = max(_significant_frequencies(c.time, c.displacement))
         else:
             top = c.crank.frequency if c.crank is not None else 2.5
@@ -280,6 +296,7 @@ def diagnose(cases: Case | Sequence[Case], *, min_gain: float = MIN_GAIN,
     findings: list[Finding] = []
     rounds: list[tuple[CandidateOutcome, ...]] = []
     measured = all(c.test.excitation == "measured" for c in cases)
+    lateral = all(c.test.rig == "lateral" for c in cases)
     for _ in range(max_rounds):
         if evidence.within_noise:
             notes.append(f"the model explains the data to within the noise (RMS residual "
@@ -323,7 +340,7 @@ def diagnose(cases: Case | Sequence[Case], *, min_gain: float = MIN_GAIN,
                 text = prop.cause
             outcomes.append(CandidateOutcome(prop.cause, prop.added, rms0, rms1, gain, dbic,
                                              reason, text, res))
-        if not any(o.cause == "sensor_delay" for o in outcomes) and not any(
+        if lateral and not any(o.cause == "sensor_delay" for o in outcomes) and not any(
                 isinstance(m, SensorDelay) for m in measurement):
             outcomes.append(CandidateOutcome(
                 "sensor_delay", ("sensor_delay",), rms0, math.nan, 0.0, 0.0,

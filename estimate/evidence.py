@@ -63,6 +63,8 @@ class Evidence:
     frequency_ratio: float | None
     pinned: tuple[str, ...]
     segments: tuple[SegmentDamping, ...] = field(default=())
+    #: Multi-channel cases: each channel's share of the scaled residual power (sums to 1).
+    channel_share: dict[str, float] = field(default_factory=dict)
 
     @property
     def within_noise(self) -> bool:
@@ -131,7 +133,13 @@ def _ljung_box(r: np.ndarray, lags: int = 20) -> tuple[float, float]:
 
 def collect_evidence(result: FitResult, *, case: int = 0, segments: tuple[SegmentDamping, ...] = ()
                      ) -> Evidence:
-    """Residual evidence of ``result`` for one case (segments computed separately)."""
+    """Residual evidence of ``result`` for one case (segments computed separately).
+
+    For a multi-channel case (spinning rig) the residual and noise are in channel-scale
+    units and the evidence that reads the carriage input (peak coherence, drive harmonics,
+    timing skew) is left empty; ``channel_share`` says where the residual is."""
+    if result.channels and len(result.channels[case]) > 1:
+        return _multichannel_evidence(result, case)
     problem = result.problem
     exp = problem.experiments[case]
     t = np.asarray(exp.case.time, float)
@@ -187,6 +195,28 @@ def collect_evidence(result: FitResult, *, case: int = 0, segments: tuple[Segmen
         frequency_ratio=ratio, pinned=pinned, segments=segments)
 
 
+def _multichannel_evidence(result: FitResult, case: int) -> Evidence:
+    problem = result.problem
+    exp = problem.experiments[case]
+    t = np.asarray(exp.case.time, float)
+    chans = result.channels[case]
+    scales = result.channel_scales[case]
+    w = result.weights[case] if result.weights else np.ones(t.size)
+    keep = w > 0
+    r = result.scaled_residuals(case)[keep]
+    power = np.sum(r**2, axis=0)
+    total = float(power.sum()) or 1.0
+    noise = [noise_floor(t, np.asarray(exp.case.channels[c], float), problem.force_cutoff_hz) / scales[c]
+             for c in chans]
+    q, pval = _ljung_box(r[:, int(np.argmax(power))])
+    pinned = tuple(wn.split("`")[1] for wn in result.warnings if "at its bound" in wn)
+    return Evidence(
+        rms_residual=float(np.sqrt(np.mean(r**2))), noise_rms=float(np.sqrt(np.mean(np.square(noise)))),
+        drive_frequency=None, sweep=False, peaks=(), harmonics={}, ljung_box_q=q,
+        ljung_box_p=pval, skew_correlation=0.0, skew_delay=0.0, frequency_ratio=None,
+        pinned=pinned, channel_share={c: float(p / total) for c, p in zip(chans, power)})
+
+
 def _carriage_acceleration(result: FitResult, case: int) -> np.ndarray | None:
     exp = result.problem.experiments[case]
     dm = exp.derived
@@ -207,7 +237,7 @@ def segment_damping(result: FitResult, *, case: int = 0, n_segments: int = 4) ->
     problem = result.problem
     exp = problem.experiments[case]
     names = set(result.names)
-    if not {"p1.damping", "p1.length"} <= names:
+    if exp.case.test.rig != "lateral" or not {"p1.damping", "p1.length"} <= names:
         return ()
     values = problem.case_values(case, result.values)
     sim = exp.simulate(values)

@@ -37,8 +37,15 @@ class Experiment:
 
     @property
     def measured(self) -> np.ndarray:
-        """The measured force (N)."""
+        """The measured force (N) of a lateral case; for several channels see
+        :attr:`channels`."""
         return self.case.force
+
+    @property
+    def channels(self) -> tuple[str, ...]:
+        """The model outputs the case measures (in the model's order)."""
+        have = self.case.channels
+        return tuple(c for c in self.derived.measured if c in have)
 
 
 def experiment(case: Case, model: Model) -> Experiment:
@@ -46,10 +53,11 @@ def experiment(case: Case, model: Model) -> Experiment:
 
     A measured displacement becomes a zero-phase smoothed displacement, velocity and
     acceleration (:func:`estimate.signals.displacement_derivatives`) interpolated by
-    cubic B-splines; a crank drive needs no input signal.
+    cubic B-splines; a crank drive and the spinning rig (whose motion is an explicit function
+    of time) need no input signal.
     """
     dm = derive(model)
-    if case.test.excitation == "measured":
+    if case.test.rig == "lateral" and case.test.excitation == "measured":
         if case.displacement is None:
             raise ValueError(f"{case.path}: excitation = 'measured' needs a displacement column")
         x, xd, xdd = displacement_derivatives(case.time, case.displacement)

@@ -106,12 +106,13 @@ def _progress_printer(names):
     return show
 
 
-def _measured_output(dm, channel: str) -> ca.Function:
+def _measured_output(dm, channels: tuple[str, ...]) -> ca.Function:
     x = ca.SX.sym("x", dm.nx)
     u = ca.SX.sym("u", dm.nu)
     p = ca.SX.sym("p", len(dm.parameter_names))
     t = ca.SX.sym("t")
-    y = dm.outputs(x, u, p, t)[OUTPUT_NAMES.index(channel)]
+    out = dm.outputs(x, u, p, t)
+    y = ca.vertcat(*[out[OUTPUT_NAMES.index(c)] for c in channels])
     return ca.Function("measured", [x, u, p, t], [y])
 
 
@@ -132,16 +133,26 @@ def _parameter_column(dm, values: Mapping[str, float], theta: ca.MX, problem: Fi
 
 
 def _measured_force(problem: FitProblem, i: int) -> tuple[np.ndarray, np.ndarray]:
-    """The recorded force as fitted (filtered, measurement models applied) and weights."""
-    case = problem.experiments[i].case
-    F = np.asarray(case.force, float)
-    if problem.force_cutoff_hz is not None:
-        F = lowpass(case.time, F, cutoff_hz=problem.force_cutoff_hz)
-    w = np.ones_like(F) if problem.weights[i] is None else np.asarray(problem.weights[i], float)
-    for mm in problem.measurement:
-        F, wm = mm.measured(case.time, F)
-        w = w * wm
-    return F, w
+    """The recorded channels as fitted (filtered, measurement models applied) and weights.
+
+    One channel (the lateral force): a 1-D array; several: ``samples x channels`` in the
+    order of :meth:`FitProblem.channels`."""
+    exp = problem.experiments[i]
+    case = exp.case
+    names = problem.channels(i)
+    have = case.channels
+    cols = []
+    w = (np.ones(case.time.size) if problem.weights[i] is None
+         else np.asarray(problem.weights[i], float))
+    for name in names:
+        F = np.asarray(have[name], float)
+        if problem.force_cutoff_hz is not None:
+            F = lowpass(case.time, F, cutoff_hz=problem.force_cutoff_hz)
+        for mm in problem.measurement:
+            F, wm = mm.measured(case.time, F)
+            w = w * wm
+        cols.append(F)
+    return (cols[0] if len(cols) == 1 else np.column_stack(cols)), w
 
 
 def fit(problem: FitProblem, *, transcription: Transcription = MultipleShooting(),
@@ -207,7 +218,7 @@ def fit(problem: FitProblem, *, transcription: Transcription = MultipleShooting(
         compile_ = blocks_ok and c_compiler() is not None
     blocks = []
     ws, w0s, gs, rs = [theta_s], [problem.initial / scales], [], []
-    measured, weights = [], []
+    measured, weights, measured_scaled, norm_parts = [], [], [], []
     extra_cols: list[int] = []
     raws: list[ca.MX] = []
     for i, exp in enumerate(problem.experiments):
@@ -224,9 +235,11 @@ def fit(problem: FitProblem, *, transcription: Transcription = MultipleShooting(
                                     theta=theta_s if blocks_ok else None, compiled=compile_)
         blocks.append(block)
         Ug = exp.excitation.values(t) if dm.nu else np.zeros((0, t.size))
-        out = _measured_output(dm, dm.measured[0]).map(t.size)
+        chans = problem.channels(i)
+        out = _measured_output(dm, chans).map(t.size)
         Y = out(block.X, ca.DM(Ug), p_i, ca.DM(t).T).T
         F, wts = _measured_force(problem, i)
+        scale = problem.channel_scales(i)
         mvals = {e.parameter: theta_s[j] * e.scale for j, e in enumerate(est)
                  if e.case in (None, i)}
         for mm in problem.measurement:
@@ -235,14 +248,36 @@ def fit(problem: FitProblem, *, transcription: Transcription = MultipleShooting(
                 Y = Y + extra
         measured.append(F)
         weights.append(wts)
-        if cost == "squared":
-            r = Y - ca.DM(F)
+        if len(chans) > 1:
+            # channel-major: each channel divided by its scale, so N and N m are comparable
+            s = np.array([scale[c] for c in chans])
+            Yv = ca.vec(Y / ca.repmat(ca.DM(s).T, t.size, 1))
+            Fv = (F / s[None, :]).ravel(order="F")
+            wv = np.tile(wts, len(chans))
+            raws.append(ca.vec(Y) - ca.DM(F.ravel(order="F")))
+            if cost == "squared":
+                r = Yv - ca.DM(Fv)
+            else:
+                eps = 1e-3 * float(np.std(Fv))
+                r = ca.sqrt(Yv**2 + eps**2) - ca.DM(np.abs(Fv))
+            if np.any(wv != 1.0):
+                r = r * ca.DM(wv)
+            measured_scaled.append(Fv[wv > 0])
+            norm_parts.append(Fv)
         else:
-            eps = 1e-3 * float(np.std(F))
-            r = ca.sqrt(Y**2 + eps**2) - ca.DM(np.abs(F))
-        raws.append(r)
-        if np.any(wts != 1.0):
-            r = r * ca.DM(wts)
+            s0 = scale[chans[0]]
+            Fs = F if s0 == 1.0 else F / s0
+            Ys = Y if s0 == 1.0 else Y / s0
+            if cost == "squared":
+                r = Ys - ca.DM(Fs)
+            else:
+                eps = 1e-3 * float(np.std(Fs))
+                r = ca.sqrt(Ys**2 + eps**2) - ca.DM(np.abs(Fs))
+            raws.append(r if s0 == 1.0 else Y - ca.DM(F))
+            if np.any(wts != 1.0):
+                r = r * ca.DM(wts)
+            measured_scaled.append(Fs[wts > 0])
+            norm_parts.append(Fs)
         if x0 is None:  # the free initial state acts as nx extra parameters
             offset = sum(int(v.numel()) for v in ws)
             extra_cols.extend(range(offset, offset + dm.nx))
@@ -253,7 +288,7 @@ def fit(problem: FitProblem, *, transcription: Transcription = MultipleShooting(
     w = ca.vertcat(*ws)
     g = ca.vertcat(*gs)
     r_all = ca.vertcat(*rs)
-    norm = float(np.mean(np.concatenate(measured) ** 2)) or 1.0
+    norm = float(np.mean(np.concatenate(norm_parts) ** 2)) or 1.0
     problem_weights = weights
     f = 0.5 * ca.sumsqr(r_all) / norm
     lbx = np.full(w.numel(), -np.inf)
@@ -291,7 +326,7 @@ def fit(problem: FitProblem, *, transcription: Transcription = MultipleShooting(
     theta = np.clip(w_opt[: len(est)] * scales, [e.lower for e in est], [e.upper for e in est])
     resid, J, raw = _reduced_jacobian(solver, residual_fn, w_opt, len(est), scales, extra_cols)
     return _result(problem, theta, stats, recorder, measured, resid, J, t_start, transcription, cost,
-                   problem_weights, raw)
+                   problem_weights, raw, measured_scaled)
 
 
 def _reduced_jacobian(solver, residual_fn, w_opt: np.ndarray, ntheta: int, scales: np.ndarray,
@@ -324,8 +359,9 @@ def _reduced_jacobian(solver, residual_fn, w_opt: np.ndarray, ntheta: int, scale
 
 
 def _result(problem, theta, stats, recorder, measured, resid, J, t_start, transcription, cost_kind,
-            weights, raw):
-    wall = np.concatenate(weights)
+            weights, raw, measured_scaled):
+    nch = [1 if np.ndim(m) == 1 else m.shape[1] for m in measured]
+    wall = np.concatenate([np.tile(w, c) for w, c in zip(weights, nch)])
     n, k = int(np.count_nonzero(wall)), J.shape[1]
     ssr = float(resid @ resid)
     dof = max(n - k, 1)
@@ -357,8 +393,12 @@ def _result(problem, theta, stats, recorder, measured, resid, J, t_start, transc
         tol = 1e-4 * span if math.isfinite(span) else 1e-5 * e.scale
         if min(v - e.lower, e.upper - v) < tol:
             warnings.append(f"`{e.name}` = {v:.6g} {e.unit} is at its bound [{e.lower:.6g}, {e.upper:.6g}]")
-    F_all = np.concatenate(measured)[wall > 0]
+    F_all = np.concatenate(measured_scaled)
     derived = derived_quantities(problem, theta, cov)
+    sizes = [int(np.size(m)) for m in measured]
+    pieces = np.split(raw, np.cumsum(sizes)[:-1])
+    residuals = tuple(p if np.ndim(m) == 1 else p.reshape(m.shape, order="F")
+                      for p, m in zip(pieces, measured))
     return FitResult(
         problem=problem,
         values=theta, stderr=stderr, covariance=cov,
@@ -368,7 +408,9 @@ def _result(problem, theta, stats, recorder, measured, resid, J, t_start, transc
         seconds=time.perf_counter() - t_start, converged=converged, status=status,
         warnings=tuple(warnings), identifiability=ident, derived=derived,
         history=np.array(recorder.thetas), cost_history=np.array(recorder.costs),
-        residuals=tuple(np.split(raw, np.cumsum([m.size for m in measured])[:-1])),
+        residuals=residuals,
+        channels=tuple(problem.channels(i) for i in range(len(measured))),
+        channel_scales=tuple(problem.channel_scales(i) for i in range(len(measured))),
         sensitivity=J,
         weights=tuple(weights),
         measured=tuple(measured), cost_kind=cost_kind, transcription=repr(transcription),

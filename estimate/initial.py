@@ -64,6 +64,18 @@ def predicted_values(case: Case, model: Model) -> dict[str, float]:
         out[f"{name}.quadratic_damping"] = 0.0
         out[f"{name}.diaphragm_stiffness"] = 0.0
         out[f"{name}.diaphragm_damping"] = 0.0
+    if "fixed.inertia" in out:
+        out.setdefault("fixed.axial_inertia", out["fixed.inertia"])
+    from analogs import Rotor
+
+    for comp in model.components:
+        if isinstance(comp, Rotor):
+            # a guess, not a prediction: 5 % of the liquid's inertia about a diameter of a
+            # sphere of the tank radius, coupled with a 1 s time constant
+            R = case.tank.radius
+            liquid = case.liquid.density * 4 / 3 * math.pi * R**3 * case.tank.fill_fraction
+            out[f"{comp.name}.inertia"] = 0.05 * 0.4 * liquid * R**2
+            out[f"{comp.name}.damping"] = out[f"{comp.name}.inertia"] / 1.0
     return {k: v for k, v in out.items() if not k.endswith(".zeta")}
 
 

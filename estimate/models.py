@@ -4,11 +4,17 @@ rig values a case file fixes."""
 from __future__ import annotations
 
 from analogs import (DiaphragmSpring, FixedMass, HingeDamper, HingeSpring, LateralRig, Model,
-                     Pendulum, QuadraticDamper)
+                     Pendulum, QuadraticDamper, Rotor, SphericalPendulum, SpinningRig)
+from analogs.component import Rig
 
 from .case import Case
 
-__all__ = ["BASELINE", "model_from_spec", "rig_values"]
+__all__ = ["BASELINE", "ROTOR_AXIS", "model_from_spec", "rig_for", "rig_values"]
+
+#: Tank axis of rotor analogs on the spinning rig: ``T.y``, the tangential direction (the
+#: way the tank origin moves), about which the nutation drives a rotor (the spin-axis
+#: component of the tank's angular acceleration is zero, see :class:`analogs.SpinningRig`).
+ROTOR_AXIS = "y"
 
 #: The default model of ``slosh simulate`` and ``slosh fit``: fixed mass + first-mode
 #: pendulum with hinge spring and linear hinge damper.
@@ -21,16 +27,34 @@ _MODIFIERS = {
 }
 
 
-def rig_for(case: Case) -> LateralRig:
-    """The rig of ``case`` (lateral; measured or crank excitation)."""
+def rig_for(case: Case) -> Rig:
+    """The rig of ``case``: :class:`analogs.LateralRig` (measured or crank excitation) or
+    :class:`analogs.SpinningRig` (``[rig.spin]`` gives its tank axis and whether gravity
+    acts)."""
+    if case.test.rig == "spinning":
+        spin = case.rig.spin
+        if spin is None:
+            raise ValueError(f"{case.path}: `rig = \"spinning\"` needs a `[rig.spin]` table")
+        return SpinningRig(gravity=spin.gravity_on, tank_axis=spin.tank_axis)
     if case.test.rig != "lateral":
-        raise ValueError(f"{case.path}: [test] rig = {case.test.rig!r} is not supported yet; "
-                         "expected 'lateral'")
+        raise ValueError(f"{case.path}: [test] rig = {case.test.rig!r} is not supported; "
+                         "expected 'lateral' or 'spinning'")
     return LateralRig(excitation=case.test.excitation)
 
 
 def rig_values(case: Case) -> dict[str, float]:
-    """Parameter values the case file fixes: dry mass, gravity and the crank geometry."""
+    """Parameter values the case file fixes: dry mass, gravity and the crank geometry, or
+    the spinning rig's motion (``[rig.spin]`` -> ``rig.spin_rate``, ``rig.radius``,
+    ``rig.height``, ``rig.nutation_angle``, ``rig.nutation_frequency``)."""
+    spin = case.rig.spin
+    if case.test.rig == "spinning" and spin is not None:
+        out = {"rig.dry_mass": case.rig.dry_mass, "rig.spin_rate": spin.rate,
+               "rig.radius": spin.radius, "rig.height": spin.height,
+               "rig.nutation_angle": spin.nutation_angle,
+               "rig.nutation_frequency": spin.nutation_frequency}
+        if spin.gravity_on:
+            out["rig.gravity"] = case.rig.gravity
+        return out
     out = {"rig.dry_mass": case.rig.dry_mass, "rig.gravity": case.rig.gravity}
     if case.test.excitation == "crank" and case.crank is not None:
         out |= {"rig.crank_radius": case.crank.radius, "rig.rod_length": case.crank.rod_length,
@@ -41,11 +65,18 @@ def rig_values(case: Case) -> dict[str, float]:
 def model_from_spec(spec: str, case: Case) -> Model:
     """Build a model from a comma-separated specification such as ``"fixed,p1,p2"``.
 
-    Tokens: ``fixed`` (FixedMass); ``pN`` (Pendulum with HingeSpring and HingeDamper),
-    optionally with modifiers after colons: ``pN:nospring`` (no hinge spring),
-    ``pN:quadratic`` (adds a QuadraticDamper), ``pN:diaphragm`` (adds a DiaphragmSpring).
+    Tokens: ``fixed`` (FixedMass); ``pN`` (Pendulum with HingeSpring and HingeDamper;
+    on the spinning rig a SphericalPendulum), optionally with modifiers after colons:
+    ``pN:nospring`` (no hinge spring), ``pN:quadratic`` (adds a QuadraticDamper),
+    ``pN:diaphragm`` (adds a DiaphragmSpring); spinning rig only: ``rotor`` or ``rN``
+    (a Rotor about the tangential tank axis :data:`ROTOR_AXIS`, coupled by a viscous damper).
+
+    Examples
+    --------
+    >>> model = model_from_spec("fixed,p1:nospring,r1", spinning_case)   # doctest: +SKIP
     """
     model: Model = Model((rig_for(case),))
+    spinning = case.test.rig == "spinning"
     problems = []
     tokens = [tok.strip() for tok in spec.replace("+", ",").split(",") if tok.strip()]
     if not tokens:
@@ -61,8 +92,16 @@ def model_from_spec(spec: str, case: Case) -> Model:
             if mods:
                 problems.append(f"{tok!r}: `fixed` takes no modifiers")
             model = model + FixedMass("fixed")
+        elif name == "rotor" or (name.startswith("r") and name[1:].isdigit()):
+            if not spinning:
+                problems.append(f"{tok!r}: a rotor needs a rig that rotates (`rig = \"spinning\"`)")
+            elif mods:
+                problems.append(f"{tok!r}: a rotor takes no modifiers")
+            else:
+                model = model + Rotor(name, axis=ROTOR_AXIS)
         elif name.startswith("p") and name[1:].isdigit():
-            model = model + Pendulum(name) + HingeDamper(name)
+            pend = SphericalPendulum(name) if spinning else Pendulum(name)
+            model = model + pend + HingeDamper(name)
             if "nospring" not in mods:
                 model = model + HingeSpring(name)
             if "quadratic" in mods:
@@ -70,7 +109,8 @@ def model_from_spec(spec: str, case: Case) -> Model:
             if "diaphragm" in mods:
                 model = model + DiaphragmSpring(name)
         else:
-            problems.append(f"{tok!r}: unknown component; expected `fixed` or `pN` (p1, p2, ...)")
+            problems.append(f"{tok!r}: unknown component; expected `fixed`, `pN` (p1, p2, ...)"
+                            + (" or `rotor`/`rN`" if spinning else ""))
     if problems:
         raise ValueError(f"--model {spec!r}: " + "; ".join(problems))
     return model.validate()

@@ -55,6 +55,8 @@ class FitProblem:
     weights: tuple[np.ndarray | None, ...] = field(default=(), repr=False)
     #: Measurement models (friction, sensor delay) applied to every case.
     measurement: tuple = field(default=())
+    #: Residual scale of a channel by output name, over the default (see :meth:`channel_scales`).
+    channel_weights: Mapping[str, float] = field(default_factory=dict)
 
     @classmethod
     def build(cls, cases: Case | Sequence[Case], model: Model, *,
@@ -64,7 +66,8 @@ class FitProblem:
               bounds: Mapping[str, tuple[float, float]] | None = None,
               force_cutoff_hz: float | None = 10.0,
               measurement: Sequence = (),
-              weights: Sequence[np.ndarray | None] | None = None) -> "FitProblem":
+              weights: Sequence[np.ndarray | None] | None = None,
+              channel_weights: Mapping[str, float] | None = None) -> "FitProblem":
         """Set up the estimation of ``model`` on ``cases``.
 
         Parameters
@@ -91,10 +94,27 @@ class FitProblem:
             parameters are estimated with the others.
         weights : sequence of arrays, optional
             Per-case sample weights (0 leaves samples out, e.g. held-out segments).
+        channel_weights : mapping of str to float, optional
+            Residual scale per measured channel (``"torque_y": 0.05`` in N m): each
+            channel's residual is divided by it. Default: 1 when a case measures one
+            channel (the lateral force, cost in N^2), else the RMS of the measured channel,
+            so that forces (N) and torques (N m) weigh alike. A smaller scale weighs a
+            channel more.
+
+        Examples
+        --------
+        >>> prob = FitProblem.build(case, model, channel_weights={"torque_z": 0.01})  # doctest: +SKIP
         """
         cases = (cases,) if isinstance(cases, Case) else tuple(cases)
         if not cases:
             raise ValueError("no cases to fit")
+        cw = dict(channel_weights or {})
+        bad = {k: v for k, v in cw.items()
+               if isinstance(v, bool) or not isinstance(v, (int, float)) or not v > 0
+               or not math.isfinite(v)}
+        if bad:
+            raise ValueError("channel_weights: expected positive finite scales (N or N m), found "
+                             + ", ".join(f"`{k}` = {v!r}" for k, v in bad.items()))
         model = model.validate()
         hold, initial_user, bounds_user = dict(hold or {}), dict(initial or {}), dict(bounds or {})
         exps = tuple(experiment(c, model) for c in cases)
@@ -156,11 +176,43 @@ class FitProblem:
             vals |= {n: v for n, v in hold.items()}
             vals |= dict(e.fixed)
             fixed.append(vals)
+        known_channels = {c for e in exps for c in e.channels}
+        stray = sorted(set(cw) - known_channels)
+        if stray:
+            raise KeyError(f"channel_weights: unknown channel{'s' if len(stray) > 1 else ''} "
+                           + ", ".join(f"`{c}`" for c in stray) + "; the cases measure "
+                           + ", ".join(sorted(known_channels)))
+        missing_ch = [e.case.test.id for e in exps if not e.channels]
+        if missing_ch:
+            raise ValueError(f"cases {', '.join(missing_ch)} measure none of the model's outputs "
+                             + ", ".join(dm.measured))
+        if measurement and any(len(e.channels) > 1 for e in exps):
+            raise ValueError("measurement models (friction, sensor delay) apply to the lateral "
+                             "force only; remove `measurement` for multi-channel cases")
         w = tuple(weights) if weights is not None else tuple(None for _ in exps)
         if len(w) != len(exps):
             raise ValueError(f"weights: expected one entry per case ({len(exps)}), got {len(w)}")
         return cls(model, exps, tuple(est), tuple(fixed), force_cutoff_hz, tuple(notes), w,
-                   tuple(measurement))
+                   tuple(measurement), cw)
+
+    def channels(self, i: int) -> tuple[str, ...]:
+        """Output names fitted for case ``i``: the model's measured outputs the case has."""
+        return self.experiments[i].channels
+
+    def channel_scales(self, i: int) -> dict[str, float]:
+        """Residual scale of each fitted channel of case ``i`` (see ``channel_weights`` of
+        :meth:`build`): 1 for a single channel, else the RMS of the raw measured channel."""
+        names = self.channels(i)
+        have = self.experiments[i].case.channels
+        out = {}
+        for c in names:
+            if c in self.channel_weights:
+                out[c] = float(self.channel_weights[c])
+            elif len(names) == 1:
+                out[c] = 1.0
+            else:
+                out[c] = float(np.sqrt(np.mean(np.asarray(have[c], float) ** 2))) or 1.0
+        return out
 
     @property
     def names(self) -> tuple[str, ...]:

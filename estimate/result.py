@@ -31,6 +31,10 @@ def derived_quantities(problem: "FitProblem", theta: np.ndarray, cov: np.ndarray
     """``pN.frequency_hz`` and ``pN.damping_ratio`` of each pendulum, with delta-method
     standard errors: ``omega^2 = g/L + k/(m L^2)``, ``zeta = c / (2 sqrt((m g L + k) m L^2))``
     with ``k`` and ``c`` the summed hinge and diaphragm stiffness and damping."""
+    from analogs import SpinningRig
+
+    if isinstance(problem.model.rig, SpinningRig):
+        return {}  # the restoring field is centrifugal and varies with the swing: no g/L
     th = ca.MX.sym("theta", theta.size)
     vals: dict[str, Any] = dict(problem.fixed[0])
     for j, e in enumerate(problem.estimated):
@@ -66,9 +70,12 @@ class FitResult:
     """The outcome of :func:`estimate.fit`.
 
     ``values``, ``stderr`` and ``covariance`` follow ``names`` (SI units, see ``units``);
-    ``cost`` is the sum of squared force residuals (N^2) over the fitted samples,
+    ``cost`` is the sum of squared force residuals (N^2) over the fitted samples (for
+    multi-channel cases: of residuals divided by their channel scales, dimensionless),
     ``residuals`` and ``measured`` hold, per case, the residual (simulated - measured, N,
-    also on samples left out by zero weights) and the (filtered) measured force;
+    also on samples left out by zero weights) and the (filtered) measured force; for a
+    multi-channel case (spinning rig) both are ``samples x channels`` arrays, columns
+    named by ``channels`` (N and N m);
     ``history`` the estimates at every IPOPT iteration.
     """
 
@@ -97,6 +104,31 @@ class FitResult:
     weights: tuple[np.ndarray, ...] = field(default=(), repr=False)
     #: Sensitivity of the (weighted) residuals to the estimates (samples x parameters).
     sensitivity: np.ndarray = field(default=None, repr=False)
+    #: Per case, the fitted output names (columns of ``residuals`` and ``measured`` when
+    #: there are several).
+    channels: tuple[tuple[str, ...], ...] = field(default=(), repr=False)
+    #: Per case, the residual scale of each channel (1 for the lateral force).
+    channel_scales: tuple[dict[str, float], ...] = field(default=(), repr=False)
+
+    def scaled_residuals(self, case: int = 0) -> np.ndarray:
+        """Residuals of ``case`` divided by their channel scales (what the cost sums):
+        1-D for one channel, ``samples x channels`` for several."""
+        r = self.residuals[case]
+        if not self.channel_scales:
+            return r
+        s = np.array([self.channel_scales[case][c] for c in self.channels[case]])
+        return r / s if r.ndim == 2 else r / s[0]
+
+    def channel(self, name: str, case: int = 0) -> tuple[np.ndarray, np.ndarray]:
+        """``(measured, residual)`` of one fitted channel of ``case`` (N or N m)."""
+        names = self.channels[case] if self.channels else ("force_x",)
+        if name not in names:
+            raise KeyError(f"{name!r} was not fitted; fitted channels: {', '.join(names)}")
+        m, r = self.measured[case], self.residuals[case]
+        if m.ndim == 1:
+            return m, r
+        j = names.index(name)
+        return m[:, j], r[:, j]
 
     @property
     def names(self) -> tuple[str, ...]:
@@ -192,6 +224,7 @@ class FitResult:
     def report(self) -> str:
         """A text fit report: statistics, estimates with intervals, derived quantities,
         correlations, identifiability, warnings."""
+        single = not self.channels or all(len(c) == 1 for c in self.channels)
         lines = ["[[Fit statistics]]",
                  f"    model              = {' + '.join(self.problem.model.names)}",
                  f"    cases              = {', '.join(e.case.test.id for e in self.problem.experiments)}",
@@ -201,8 +234,8 @@ class FitResult:
                  f"    wall time          = {self.seconds:.3f} s",
                  f"    data points        = {self.n_samples}",
                  f"    variables          = {len(self.names)}",
-                 f"    cost (sum r^2)     = {self.cost:.6g} N^2",
-                 f"    RMS residual       = {self.rms_residual:.6g} N",
+                 f"    cost (sum r^2)     = {self.cost:.6g} {'N^2' if single else '(scaled)'}",
+                 f"    RMS residual       = {self.rms_residual:.6g} {'N' if single else '(scaled)'}",
                  f"    R^2                = {self.r_squared:.6f}",
                  "[[Variables]]"]
         for name, v, se, e in zip(self.names, self.values, self.stderr, self.problem.estimated):
@@ -226,6 +259,15 @@ class FitResult:
         lines.append(f"    condition number of the scaled sensitivity = {self.identifiability.condition_number:.3g}")
         conf = self.confounded()
         lines += [f"    {c}" for c in conf] or ["    every estimated parameter is determined by the data"]
+        if not single:
+            lines.append("[[Channels]] (residual scale, RMS residual / scale)")
+            for i, names in enumerate(self.channels):
+                r = self.scaled_residuals(i)
+                keep = self.weights[i] > 0 if self.weights else slice(None)
+                for j, c in enumerate(names):
+                    rms = float(np.sqrt(np.mean(r[keep, j] ** 2)))
+                    lines.append(f"    {c:12s} scale {self.channel_scales[i][c]:.4g}  "
+                                 f"RMS residual {rms:.4g}")
         lines.append("[[Notes]]")
         lines.append("    " + _AUTOCORRELATION_NOTE)
         lines += [f"    {n}" for n in self.problem.notes]

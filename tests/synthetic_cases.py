@@ -56,3 +56,33 @@ def pendulum(mass=1.30, length=0.0553, zeta=0.01, stiffness=0.0, quadratic_dampi
     return ref.Pendulum(mass, length, stiffness,
                         ref.hinge_damping(mass, length, zeta, stiffness=stiffness, gravity=G),
                         quadratic_damping)
+
+
+def make_spinning_case(folder: Path, name: str, rig, *, pendulum=None, rotor=None,
+                       fixed_mass=0.0, fixed_height=0.0, noise=0.01, duration=20.0,
+                       rate=100.0, seed=0, tank_radius=0.2, fill=0.6,
+                       prediction: Prediction | None = None):
+    """Simulate with ``reference_spinning.simulate_spinning`` (six channels) and write
+    ``name.toml``/``.csv`` for ``rig = "spinning"``. ``rig`` is a ``reference_spinning.Rig``.
+    Returns ``(case, simulation dict)``."""
+    import reference_spinning as rs
+    from estimate.case import Spin
+
+    t = np.arange(int(round(duration * rate)) + 1) / rate
+    sim = rs.simulate_spinning(t, rig, pendulum=pendulum, rotor=rotor, fixed_mass=fixed_mass,
+                               fixed_height=fixed_height, noise=noise, seed=seed)
+    gravity_on = rig.gravity > 0
+    case = write_case(
+        Path(folder) / f"{name}.toml",
+        test=TestInfo(id=name, rig="spinning", data=f"{name}.csv", excitation="spin",
+                      note="SYNTHETIC test data from tests/reference_spinning.py"),
+        tank=Tank(shape="sphere", radius=tank_radius, fill_fraction=fill, diaphragm=False),
+        liquid=Liquid(density=998.2, kinematic_viscosity=1.004e-6),
+        rig=Rig(dry_mass=rig.dry_mass, gravity=rig.gravity if gravity_on else G,
+                spin=Spin(rate=rig.spin_rate, radius=rig.radius,
+                          nutation_angle=rig.nutation_angle,
+                          nutation_frequency=rig.nutation_frequency, height=rig.height,
+                          gravity_on=gravity_on)),
+        time=t, channels={c: sim[c] for c in rs.CHANNELS}, prediction=prediction,
+        comment="SYNTHETIC test case (tests/synthetic_cases.py)", overwrite=True)
+    return case, sim

@@ -219,8 +219,8 @@ def test_fill_fraction_outside_unit_interval(tmp_path: Path, fill: str) -> None:
 @pytest.mark.parametrize(
     ("old", "new", "pattern"),
     [
-        ('rig = "lateral"', 'rig = "spinning"',
-         r'\[test\] rig: unknown value "spinning" \(expected one of "lateral"\)'),
+        ('rig = "lateral"', 'rig = "rotating"',
+         r'\[test\] rig: unknown value "rotating" \(expected one of "lateral", "spinning"\)'),
         ('excitation = "measured"', 'excitation = "sine"',
          r'\[test\] excitation: unknown value "sine" \(expected one of "measured", "crank"\)'),
         ('shape = "sphere"', 'shape = "cube"',
@@ -475,3 +475,102 @@ def test_bundled_examples_are_reproducible(tmp_path: Path) -> None:
     params = json.loads((EXAMPLES / "A1_params.json").read_text())
     assert sorted(params) == ["fixed.mass", "p1.damping", "p1.length", "p1.mass", "p1.stiffness"]
     assert json.loads((tmp_path / "A1_params.json").read_text()) == pytest.approx(params)
+
+
+# -- spinning rig -------------------------------------------------------------------------
+
+SPIN_TOML = GOOD_TOML.replace('rig = "lateral"', 'rig = "spinning"').replace(
+    'excitation = "measured"\n', "").replace("data = \"A1.csv\"", "data = \"S1.csv\"") + """
+[rig.spin]
+rate = 6.0
+radius = 0.4
+nutation_angle = 0.06
+nutation_frequency = 0.3
+"""
+SPIN_COLUMNS = ("force_x", "force_y", "force_z", "torque_x", "torque_y", "torque_z")
+
+
+def _spin_csv(n: int = 60, header: str = "time," + ",".join(SPIN_COLUMNS) + ",table_angle") -> str:
+    t = np.arange(n) * 0.01
+    cols = header.split(",")
+    rows = [",".join(["%.2f" % ti] + [str(np.sin(ti + k)) for k in range(len(cols) - 1)])
+            for ti in t]
+    return "\n".join([header, *rows]) + "\n"
+
+
+def _write_spin(tmp_path: Path, toml: str = SPIN_TOML, csv_text: str | None = None) -> Path:
+    (tmp_path / "S1.csv").write_text(_spin_csv() if csv_text is None else csv_text)
+    path = tmp_path / "S1.toml"
+    path.write_text(toml)
+    return path
+
+
+def test_spinning_case_loads_with_channels_and_defaults(tmp_path: Path) -> None:
+    case = load_case(_write_spin(tmp_path))
+    assert case.test.rig == "spinning" and case.test.excitation == "spin"
+    assert case.spin is not None and case.spin.rate == 6.0 and case.spin.height == 0.0
+    assert case.spin.tank_axis == "spin" and case.spin.gravity_on
+    assert set(case.channels) == set(SPIN_COLUMNS) | {"table_angle"}
+    assert case.force is None
+    with pytest.raises(ValueError):
+        case.channels["torque_y"][0] = 1.0  # read-only
+
+
+def test_lateral_case_channels_are_the_force(tmp_path: Path) -> None:
+    case = load_case(_write(tmp_path, GOOD_TOML))
+    assert list(case.channels) == ["force_x"]
+    assert np.array_equal(case.channels["force_x"], case.force)
+
+
+def test_spinning_case_reports_every_problem(tmp_path: Path) -> None:
+    toml = SPIN_TOML.replace("rate = 6.0", 'rate = "fast"').replace(
+        "nutation_angle = 0.06", "nutation_angle = 2.0") + 'tank_axis = "radial"\n'
+    header = "time,force_x,force_y,force_z,torque_x,torque_y"
+    with pytest.raises(CaseError) as err:
+        load_case(_write_spin(tmp_path, toml, _spin_csv(header=header)))
+    text = str(err.value)
+    assert "4 problems" in text
+    assert re.search(r"S1.toml: \[rig.spin\] rate: expected a number in rad/s, found a string", text)
+    assert re.search(r"\[rig.spin\] nutation_angle: expected a cone half-angle below pi/2 rad, "
+                     r"found 2.0 rad", text)
+    assert re.search(r'\[rig.spin\] tank_axis: unknown value "radial" \(expected one of "spin", '
+                     r'"inward"\)', text)
+    assert re.search(r"S1.csv: header \(line 1\): expected `time,force_x,force_y,force_z,torque_x,"
+                     r"torque_y,torque_z` .* \(no column `torque_z`\)", text)
+
+
+def test_spinning_case_needs_the_spin_table_and_rejects_lateral_excitations(tmp_path: Path) -> None:
+    toml = SPIN_TOML.split("[rig.spin]")[0].replace('rig = "spinning"',
+                                                      'rig = "spinning"\nexcitation = "crank"')
+    with pytest.raises(CaseError, match=r"(?s)\[test\] excitation: unknown value \"crank\" "
+                                        r"\(expected one of \"spin\"\).*\[rig.spin\]: missing table"):
+        load_case(_write_spin(tmp_path, toml))
+
+
+def test_spinning_csv_nan_is_reported_with_column_and_line(tmp_path: Path) -> None:
+    lines = _spin_csv().splitlines()
+    fields = lines[5].split(",")
+    fields[5] = "nan"  # torque_y
+    lines[5] = ",".join(fields)
+    with pytest.raises(CaseError, match=r"S1.csv: column `torque_y`: expected finite numbers, "
+                                        r"found 1 NaN or inf value\(s\) at line 6"):
+        load_case(_write_spin(tmp_path, csv_text="\n".join(lines) + "\n"))
+
+
+def test_write_case_round_trips_a_spinning_case(tmp_path: Path) -> None:
+    from estimate.case import Spin
+
+    case = load_case(_write_spin(tmp_path))
+    out = write_case(tmp_path / "out" / "S2.toml",
+                     test=TestInfo(id="S2", rig="spinning", data="S2.csv", excitation="spin"),
+                     tank=case.tank, liquid=case.liquid,
+                     rig=Rig(dry_mass=2.0, gravity=9.80665,
+                             spin=Spin(6.0, 0.4, 0.06, 0.3, height=0.1, tank_axis="inward",
+                                       gravity_on=False)),
+                     time=case.time, channels=case.channels)
+    assert out.spin == Spin(6.0, 0.4, 0.06, 0.3, height=0.1, tank_axis="inward", gravity_on=False)
+    for k, v in case.channels.items():
+        assert np.allclose(out.channels[k], v, rtol=1e-11)
+    with pytest.raises(ValueError, match="a spinning-rig case takes `channels`"):
+        write_case(tmp_path / "x.toml", test=out.test, tank=out.tank, liquid=out.liquid,
+                   rig=out.rig, time=case.time, force=case.time)
