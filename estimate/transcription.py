@@ -96,7 +96,7 @@ class MultipleShooting(Transcription):
         # p = p0 + S theta (affine); per-interval value and Jacobians in one function
         S = ca.evalf(ca.jacobian(p, theta))
         p0 = ca.evalf(ca.substitute(p, theta, ca.DM.zeros(theta.numel())))
-        fn = _step_with_jacobians(dm, self.substeps, compiled)
+        fn = _step_jacobian(dm, self.substeps, theta.numel(), compiled)
         xn, JxT, JtT = fn.map(n - 1)(X[:, :-1], U, p0, ca.vec(S), theta, tk, hk)
         # g stays differentiable by CasADi (interpreted step); the possibly compiled
         # function only feeds the constraint Jacobian, which IPOPT asks for directly
@@ -107,58 +107,29 @@ class MultipleShooting(Transcription):
                      ca.vec(X[:, 1:] - xn))
 
 
-def _step_with_jacobians(dm: DerivedModel, substeps: int, compiled: bool) -> ca.Function:
+def _step_jacobian(dm: DerivedModel, substeps: int, ntheta: int, compiled: bool) -> ca.Function:
     """``(x, U, p0, vec(S), theta, t, h) -> (x_next, (dx_next/dx)^T, (dx_next/dtheta)^T)``
-    with ``p = p0 + S theta``; transposed blocks so that mapped outputs stack by rows."""
-    key = ("rk4_jacobian", substeps, compiled)
-    if key in dm._memo:
-        return dm._memo[key]
-    step = rk4_step(dm, substeps)
-    npar = len(dm.parameter_names)
-    x = ca.SX.sym("x", dm.nx)
-    U = ca.SX.sym("U", step.size1_in(1))
-    p0 = ca.SX.sym("p0", npar)
-    dm._memo[key] = _StepJac(step, x, U, p0, npar, compiled)
+    with ``p = p0 + S theta``; blocks are transposed so that mapped outputs stack by rows.
+    Built (and compiled) once per model, substeps and number of estimates."""
+    key = ("rk4_jacobian", substeps, ntheta, compiled)
+    if key not in dm._memo:
+        step = rk4_step(dm, substeps)
+        npar = len(dm.parameter_names)
+        x = ca.SX.sym("x", dm.nx)
+        U = ca.SX.sym("U", step.size1_in(1))
+        p0 = ca.SX.sym("p0", npar)
+        th = ca.SX.sym("theta", ntheta)
+        Sv = ca.SX.sym("S", npar * ntheta)
+        t, h = ca.SX.sym("t"), ca.SX.sym("h")
+        xn = step(x, U, p0 + ca.mtimes(ca.reshape(Sv, npar, ntheta), th), t, h)
+        fn = ca.Function("rk4_jacobian", [x, U, p0, Sv, th, t, h],
+                         [xn, ca.jacobian(xn, x).T, ca.jacobian(xn, th).T])
+        if compiled:
+            from derive._compile import compiled as compile_fn
+
+            fn = compile_fn(fn)
+        dm._memo[key] = fn
     return dm._memo[key]
-
-
-class _StepJac:
-    """Builds (and caches) the per-interval function for a given number of parameters."""
-
-    def __init__(self, step, x, U, p0, npar, compiled):
-        self.step, self.x, self.U, self.p0, self.npar, self.compiled = step, x, U, p0, npar, compiled
-        self.cache: dict[int, ca.Function] = {}
-
-    def map(self, n: int):
-        def call(X, U, p0, Svec, theta, tk, hk):
-            ntheta = theta.numel()
-            fn = self._function(ntheta)
-            return fn.map(n)(X, U, p0, Svec, theta, tk, hk)
-        return _Caller(call)
-
-    def _function(self, ntheta: int) -> ca.Function:
-        if ntheta not in self.cache:
-            th = ca.SX.sym("theta", ntheta)
-            Sv = ca.SX.sym("S", self.npar * ntheta)
-            t, h = ca.SX.sym("t"), ca.SX.sym("h")
-            p = self.p0 + ca.mtimes(ca.reshape(Sv, self.npar, ntheta), th)
-            xn = self.step(self.x, self.U, p, t, h)
-            fn = ca.Function("rk4_jacobian", [self.x, self.U, self.p0, Sv, th, t, h],
-                             [xn, ca.jacobian(xn, self.x).T, ca.jacobian(xn, th).T])
-            if self.compiled:
-                from derive._compile import compiled as compile_fn
-
-                fn = compile_fn(fn)
-            self.cache[ntheta] = fn
-        return self.cache[ntheta]
-
-
-class _Caller:
-    def __init__(self, fn):
-        self._fn = fn
-
-    def __call__(self, *args):
-        return self._fn(*args)
 
 
 def _bidiagonal(nx: int, n: int, negJ: ca.MX, *, fixed_start: bool) -> ca.MX:
