@@ -13,7 +13,7 @@ from analogs.model import Model
 from .derived import OUTPUT_NAMES, DerivedModel
 from .excitation import Excitation, NoExcitation
 
-__all__ = ["RK4", "Adaptive", "Simulation", "simulate", "rk4_step"]
+__all__ = ["RK4", "Adaptive", "Simulation", "simulate", "rk4_step", "interval_inputs"]
 
 
 @dataclass(frozen=True)
@@ -239,9 +239,7 @@ def simulate(
             U = np.zeros((0, n))
             Ug = np.zeros((0, n + 1))
         else:
-            frac = np.arange(2 * s + 1) / (2 * s)
-            stage_t = (t[:-1, None] + h[:, None] * frac[None, :]).ravel()
-            U = _stage_inputs(exc, stage_t, dm.nu, n, 2 * s + 1)
+            U = interval_inputs(exc, t, np.arange(2 * s + 1) / (2 * s), dm.nu)
             Ug = exc.values(t).reshape(dm.nu, t.size)
         fn = _simulator(dm, exc, s, n, idx, integrator.compiled)
         X, Y = fn(x_init, U, p, t.reshape(1, -1), h.reshape(1, -1), Ug)
@@ -258,10 +256,17 @@ def simulate(
                       state_names=dm.states, input_names=dm.inputs, output_names=names)
 
 
-def _stage_inputs(exc: Excitation, stage_t: np.ndarray, nu: int, n: int, m: int) -> np.ndarray:
-    """Inputs at the stage times as a ``(nu * m, n)`` array: column k stacks the ``m`` stage
-    input vectors of interval k (column-major, as ``reshape(U_k, nu, m)`` expects)."""
-    vals = exc.values(stage_t).reshape(nu, n, m)  # [channel, interval, stage]
+def interval_inputs(exc: Excitation | None, t: np.ndarray, fractions: np.ndarray,
+                    nu: int) -> np.ndarray:
+    """Inputs at ``t_k + f h_k`` for every interval ``k`` and fraction ``f`` of ``fractions``,
+    as a ``(nu * len(fractions), n)`` array: column k stacks the input vectors of interval
+    k, first fraction first (what ``reshape(U_k, nu, m)`` and :func:`rk4_step` expect)."""
+    t = np.asarray(t, float)
+    n, m = t.size - 1, len(fractions)
+    if nu == 0:
+        return np.zeros((0, n))
+    times = (t[:-1, None] + np.diff(t)[:, None] * np.asarray(fractions)[None, :]).ravel()
+    vals = np.asarray(exc.values(times), float).reshape(nu, n, m)  # [channel, interval, stage]
     return np.ascontiguousarray(vals.transpose(1, 2, 0).reshape(n, m * nu).T)
 
 

@@ -177,11 +177,9 @@ def derived_quantities(dm: DerivedModel, P: np.ndarray) -> dict[str, np.ndarray]
 def _stage_inputs(exc: Excitation, t: np.ndarray, nu: int) -> tuple[np.ndarray, np.ndarray]:
     """Inputs at the RK4 stage times ``(3 nu, n)`` (stage by stage in each column) and on
     the grid ``(nu, n + 1)``, as :func:`derive.simulate` samples them."""
-    n = t.size - 1
-    h = np.diff(t)
-    stage_t = (t[:-1, None] + h[:, None] * np.array([0.0, 0.5, 1.0])[None, :]).ravel()
-    vals = np.asarray(exc.values(stage_t), float).reshape(nu, n, 3)
-    U = np.ascontiguousarray(vals.transpose(1, 2, 0).reshape(n, 3 * nu).T)
+    from derive.simulate import interval_inputs
+
+    U = interval_inputs(exc, t, np.array([0.0, 0.5, 1.0]), nu)
     return U, np.asarray(exc.values(t), float).reshape(nu, t.size)
 
 

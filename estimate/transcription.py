@@ -15,6 +15,7 @@ import casadi as ca
 import numpy as np
 
 from derive import DerivedModel, Excitation, rk4_step
+from derive.simulate import interval_inputs
 
 __all__ = ["Transcription", "MultipleShooting", "Collocation", "Block"]
 
@@ -55,16 +56,6 @@ class Transcription:
         raise NotImplementedError
 
 
-def _interval_inputs(exc: Excitation | None, t: np.ndarray, frac: np.ndarray, nu: int) -> np.ndarray:
-    n = t.size - 1
-    if nu == 0:
-        return np.zeros((0, n))
-    h = np.diff(t)
-    times = (t[:-1, None] + h[:, None] * frac[None, :]).ravel()
-    vals = exc.values(times).reshape(nu, n, frac.size)
-    return np.ascontiguousarray(vals.transpose(1, 2, 0).reshape(n, frac.size * nu).T)
-
-
 def _states_with_fixed_start(nx: int, n: int, x_guess: np.ndarray, x0: np.ndarray | None):
     if x0 is None:
         W = ca.MX.sym("X", nx, n)
@@ -82,7 +73,7 @@ class MultipleShooting(Transcription):
     substeps: int = 1
 
     def inputs(self, exc, t, nu):
-        return _interval_inputs(exc, t, np.arange(2 * self.substeps + 1) / (2 * self.substeps), nu)
+        return interval_inputs(exc, t, np.arange(2 * self.substeps + 1) / (2 * self.substeps), nu)
 
     def block(self, dm, p, t, exc, x_guess, x0, theta=None, compiled=False):
         n = t.size
@@ -196,7 +187,7 @@ class Collocation(Transcription):
 
     def inputs(self, exc, t, nu):
         tau, _, _ = self._coefficients()
-        return _interval_inputs(exc, t, tau[1:], nu)
+        return interval_inputs(exc, t, tau[1:], nu)
 
     def block(self, dm, p, t, exc, x_guess, x0, theta=None, compiled=False):
         n, nx, d = t.size, dm.nx, self.degree
