@@ -150,7 +150,7 @@ class FitResult:
 
     @property
     def correlation(self) -> np.ndarray:
-        d = np.sqrt(np.diag(self.covariance))
+        d = np.sqrt(np.clip(np.diag(self.covariance), 0, None))
         with np.errstate(invalid="ignore", divide="ignore"):
             c = self.covariance / np.outer(d, d)
         return np.nan_to_num(c)
