@@ -34,6 +34,14 @@ def test_identifiable_parameters_recovered_within_two_percent(sine_case):
     assert res.derived["p1.frequency_hz"][0] == pytest.approx(f_true, rel=RECOVERY / 10)
     assert res.derived["p1.damping_ratio"][0] == pytest.approx(0.01, rel=RECOVERY)
     assert not res.identifiability.groups
+    # the fit plot: force panel, residual, spectra, trajectories over the IPOPT iterations
+    from estimate.plots import plot_fit
+
+    fig = plot_fit(res)
+    assert len(fig.axes) == 4
+    measured_line, simulated_line = fig.axes[0].get_lines()
+    assert np.allclose(simulated_line.get_ydata(), res.simulated(0))
+    assert len(fig.axes[3].get_lines()) == len(res.names)
 
 
 def test_length_and_spring_confound_is_reported_with_the_frequency(sine_case):

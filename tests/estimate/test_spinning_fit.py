@@ -48,6 +48,14 @@ def test_six_channel_fit_recovers_rotor_and_pendulum(spinning_case):
     # default channel scales: the RMS of each measured channel
     rms = float(np.sqrt(np.mean(case.channels["torque_z"] ** 2)))
     assert res.channel_scales[0]["torque_z"] == pytest.approx(rms)
+    # the fit plot shows every channel: measured, and simulated = measured + residual
+    from estimate.plots import plot_fit
+
+    fig = plot_fit(res)
+    assert len(fig.axes) == 6 + 3
+    measured_line, simulated_line = fig.axes[4].get_lines()
+    assert np.allclose(measured_line.get_ydata(), meas)
+    assert np.allclose(simulated_line.get_ydata(), meas + resid)
 
 
 def test_channel_weights_override_the_default_scale(spinning_case):
