@@ -54,6 +54,19 @@ def _freq(res: FitResult, name: str) -> float:
     return res.derived.get(f"{name}.frequency_hz", (math.nan, 0))[0]
 
 
+def _probe_regression(probe, J, r):
+    """Regress the residual ``r`` on a unit probe response and the fit's sensitivity ``J``
+    (one Gauss-Newton step of the extended model). Returns the probe's size (the residual is
+    simulated - measured, so a missing element enters with minus its size) and the explained
+    fraction of the residual."""
+    import numpy as np
+
+    A = np.column_stack([probe, J])
+    coef, *_ = np.linalg.lstsq(A, r, rcond=None)
+    explained = 1 - float(np.sum((r - A @ coef) ** 2) / np.sum(r**2))
+    return -float(coef[0]), explained
+
+
 def scan_mode(current: FitResult, f_lo: float, f_hi: float, *, n: int = 120, case: int = 0,
               zeta: float = 0.02) -> tuple[float, float, float] | None:
     """Matched scan for an unmodelled slosh mode: for trial frequencies in ``[f_lo, f_hi]``
@@ -87,12 +100,9 @@ def scan_mode(current: FitResult, f_lo: float, f_hi: float, *, n: int = 120, cas
         sim = simulate(probe, {"rig.dry_mass": 0.0, "rig.gravity": g, "q.mass": 1.0, "q.length": L,
                                "q.damping": 2 * zeta * L**2 * om}, t, exp.excitation,
                        outputs=("force_x",))
-        A = np.column_stack([sim.outputs[:, 0][w], J])
-        coef, *_ = np.linalg.lstsq(A, r, rcond=None)
-        mass = -float(coef[0])  # residual = simulated - measured: a missing mode enters with -m
+        mass, explained = _probe_regression(sim.outputs[:, 0][w], J, r)
         if mass <= 0:
             continue
-        explained = 1 - float(np.sum((r - A @ coef) ** 2) / np.sum(r**2))
         if best is None or explained > best[2]:
             best = (float(f), mass, explained)
     return best
@@ -134,12 +144,9 @@ def scan_rotor(current: FitResult, *, case: int = 0, n: int = 16,
         sim = simulate(probe, {**values, "q.inertia": 1.0, "q.damping": float(rate)}, t,
                        integrator=RK4(), outputs=chans)
         y = (sim.outputs / scales[None, :]).ravel(order="F")[w]
-        A = np.column_stack([y, J])
-        coef, *_ = np.linalg.lstsq(A, r, rcond=None)
-        inertia = -float(coef[0])  # residual = simulated - measured: a missing rotor enters with -J
+        inertia, explained = _probe_regression(y, J, r)
         if inertia <= 0:
             continue
-        explained = 1 - float(np.sum((r - A @ coef) ** 2) / np.sum(r**2))
         if best is None or explained > best[2]:
             best = (inertia, inertia * float(rate), explained)
     return best
