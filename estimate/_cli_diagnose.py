@@ -6,6 +6,8 @@ import argparse
 import json
 from pathlib import Path
 
+from ._outputs import refuse_existing
+
 __all__ = ["add_parser"]
 
 
@@ -29,8 +31,7 @@ def run(args: argparse.Namespace) -> int:
     from .diagnosis_report import _json_default, summary, write_report
 
     out = Path(args.json_out)
-    if out.exists() and not args.overwrite:
-        raise FileExistsError(f"{out} exists; pass --overwrite to replace it")
+    refuse_existing([out], args.overwrite)
     d = diagnose([load_case(c) for c in args.cases])
     out.write_text(json.dumps(d.to_dict(), indent=2, default=_json_default))
     if args.report:

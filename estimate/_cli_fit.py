@@ -6,6 +6,8 @@ import argparse
 import json
 from pathlib import Path
 
+from ._outputs import refuse_existing
+
 __all__ = ["add_parser"]
 
 
@@ -38,10 +40,7 @@ def run(args: argparse.Namespace) -> int:
     from .problem import FitProblem
     from .transcription import Collocation, MultipleShooting
 
-    outputs = [Path(x) for x in (args.json_out, args.plot) if x]
-    existing = [str(p) for p in outputs if p.exists()]
-    if existing and not args.overwrite:
-        raise FileExistsError(f"{', '.join(existing)} exist(s); pass --overwrite to replace")
+    refuse_existing([args.json_out, args.plot], args.overwrite)
     cases = [load_case(c) for c in args.cases]
     spec = args.model or BASELINE
     model = model_from_spec(spec, cases[0])

@@ -10,6 +10,8 @@ import argparse
 import json
 from pathlib import Path
 
+from ._outputs import refuse_existing
+
 __all__ = ["add_parser", "run"]
 
 
@@ -51,10 +53,7 @@ def run(args: argparse.Namespace) -> int:
     if args.samples < 1:
         raise ValueError(f"--samples must be at least 1, got {args.samples}")
     out = Path(args.out)
-    files = [out / "montecarlo.json", out / "envelope.png"]
-    existing = [str(f) for f in files if f.exists()]
-    if existing and not args.overwrite:
-        raise FileExistsError(f"{', '.join(existing)} exist; pass --overwrite to replace them")
+    refuse_existing([out / "montecarlo.json", out / "envelope.png"], args.overwrite)
     fit = read_fit(args.fit)
     case = load_case(args.case)
     exp = experiment(case, model_from_spec(args.model or fit.model_spec, case))

@@ -7,6 +7,8 @@ import os
 import sys
 from pathlib import Path
 
+from ._outputs import refuse_existing
+
 __all__ = ["main"]
 
 
@@ -39,8 +41,7 @@ def _run_simulate(args: argparse.Namespace) -> int:
     from .params_io import read_params
 
     out = Path(args.out)
-    if out.exists() and not args.overwrite:
-        raise FileExistsError(f"{out} exists; pass --overwrite to replace it")
+    refuse_existing([out], args.overwrite)
     case = load_case(args.case)
     params = read_params(args.params)
     exp = experiment(case, model_from_spec(args.model or BASELINE, case))
