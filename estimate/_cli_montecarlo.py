@@ -53,7 +53,8 @@ def run(args: argparse.Namespace) -> int:
     if args.samples < 1:
         raise ValueError(f"--samples must be at least 1, got {args.samples}")
     out = Path(args.out)
-    refuse_existing([out / "montecarlo.json", out / "envelope.png"], args.overwrite)
+    files = [out / "montecarlo.json", out / "envelope.png"]
+    refuse_existing(files, args.overwrite)
     fit = read_fit(args.fit)
     case = load_case(args.case)
     exp = experiment(case, model_from_spec(args.model or fit.model_spec, case))

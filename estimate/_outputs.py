@@ -9,8 +9,8 @@ __all__ = ["refuse_existing"]
 
 
 def refuse_existing(paths: Iterable[str | Path | None], overwrite: bool) -> None:
-    """Raise FileExistsError naming every existing file in ``paths`` (``None`` skipped)
+    """Raise FileExistsError naming every existing file in ``paths`` (``None`` and "" skipped)
     unless ``overwrite`` is true."""
-    existing = [str(p) for p in paths if p is not None and Path(p).exists()]
+    existing = [str(p) for p in paths if p and Path(p).exists()]
     if existing and not overwrite:
         raise FileExistsError(f"{', '.join(existing)} exist(s); pass --overwrite to replace")
