@@ -43,6 +43,8 @@ import sys
 import tomllib
 from pathlib import Path
 
+from ._outputs import refuse_existing
+
 __all__ = ["add_parser", "run", "load_spacecraft"]
 
 _BUS_KEYS = ("spin_rate", "mass", "inertia_x", "inertia_y", "inertia_z")
@@ -64,6 +66,7 @@ def add_parser(subparsers: argparse._SubParsersAction) -> None:
                     "the equations linearised about steady spin.")
     p.add_argument("spacecraft", help="spacecraft file (TOML)")
     p.add_argument("--json", metavar="OUT.json", help="write both NTCs as JSON")
+    p.add_argument("--overwrite", action="store_true", help="replace an existing --json file")
     p.set_defaults(func=run)
 
 
@@ -188,6 +191,7 @@ def run(args: argparse.Namespace) -> int:
     """Run ``slosh ntc``; returns the exit status."""
     from .ntc import nutation_time_constant
 
+    refuse_existing([args.json], args.overwrite)
     model, params, options = load_spacecraft(args.spacecraft)
     ntc = nutation_time_constant(model, params, **options)
     print(f"{args.spacecraft}: {model!r}")

@@ -12,6 +12,8 @@ import sys
 
 from analogs.tank import Capsule, Cylinder, Liquid, Sphere, predict
 
+from ._outputs import refuse_existing
+
 __all__ = ["add_parser", "run"]
 
 _SHAPES = ("sphere", "cylinder", "capsule")
@@ -40,6 +42,7 @@ def add_parser(subparsers: argparse._SubParsersAction) -> None:
     p.add_argument("--json", metavar="OUT.json", help="write the prediction as JSON")
     p.add_argument("--plot", metavar="OUT.png",
                    help="plot slosh/fixed mass and frequencies against fill")
+    p.add_argument("--overwrite", action="store_true", help="replace existing output files")
     p.set_defaults(func=run)
 
 
@@ -83,6 +86,7 @@ def _plot(args: argparse.Namespace, tank, liquid: Liquid, path: str) -> None:
 
 def run(args: argparse.Namespace) -> int:
     """Run ``slosh tank``; returns the exit status (2 on bad input)."""
+    refuse_existing([args.json, args.plot], args.overwrite)
     try:
         tank = _tank(args)
         liquid = Liquid(density=args.density, viscosity=args.viscosity, name="liquid")
