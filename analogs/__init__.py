@@ -9,6 +9,7 @@ model into equations of motion. Models compose with ``+``::
 """
 
 from .component import Attachment, Component, Rig
+from .errors import InputError, UnknownNameError
 from .fixed_mass import FixedMass
 from .hinge import DiaphragmSpring, HingeDamper, HingeSpring, QuadraticDamper
 from .model import Model, ModelError
@@ -30,6 +31,7 @@ __all__ = [
     "FreeSpacecraft",
     "HingeDamper",
     "HingeSpring",
+    "InputError",
     "LateralRig",
     "Model",
     "ModelError",
@@ -43,6 +45,7 @@ __all__ = [
     "SphericalPendulum",
     "SpinningRig",
     "SuspendedMass",
+    "UnknownNameError",
     "VehicleFrame",
     "body_angular_velocity",
     "crank_displacement",

@@ -4,16 +4,51 @@ from __future__ import annotations
 
 import hashlib
 import inspect
+import sys
 from collections.abc import Mapping
-from typing import TYPE_CHECKING, ClassVar
+from typing import TYPE_CHECKING, Any, ClassVar
 
+from .errors import InputError
 from .parameter import Param, Parameter
 
 if TYPE_CHECKING:  # pragma: no cover
     from .declaration import Declaration, FrameDeclaration
     from .model import Model
 
-__all__ = ["Component", "Attachment", "Rig"]
+__all__ = ["Component", "Attachment", "Rig", "SourceUnavailable"]
+
+
+class SourceUnavailable(RuntimeError):
+    """The source of a component class (or of the module defining it) cannot be read, e.g.
+    a class made with ``exec``: its equations cannot be keyed for the derivation cache."""
+
+    def __init__(self, cls: type, what: str) -> None:
+        self.cls = cls
+        super().__init__(
+            f"the source of {what} of {cls.__module__}.{cls.__qualname__} cannot be read "
+            "(a class made with `exec` or typed into an interactive interpreter?)")
+
+
+def source_digest(cls: type) -> str:
+    """Hash of the source of every class in ``cls``'s MRO (up to :class:`Component`) and of
+    the modules defining them, so that a change to a base class or to a module-level helper
+    that ``declare`` calls changes the digest. Raises :class:`SourceUnavailable`."""
+    h = hashlib.sha256()
+    for klass in cls.__mro__:
+        if klass is object:
+            continue
+        try:
+            h.update(inspect.getsource(klass).encode())
+        except (OSError, TypeError):
+            raise SourceUnavailable(klass, "the class") from None
+        module = sys.modules.get(klass.__module__)
+        try:
+            h.update(inspect.getsource(module).encode())  # type: ignore[arg-type]
+        except (OSError, TypeError):
+            raise SourceUnavailable(klass, "the module") from None
+        if klass is Component:
+            break
+    return h.hexdigest()[:16]
 
 
 class Component:
@@ -42,6 +77,11 @@ class Component:
 
     #: Local names of the generalized coordinates the component adds.
     coordinates: ClassVar[tuple[str, ...]] = ()
+    #: SI unit of each coordinate by local name (``"rad"``, ``"m"``); every coordinate
+    #: needs one (exports and reports read it here).
+    coordinate_units: ClassVar[Mapping[str, str]] = {}
+    #: Quantities derived from the parameters (:meth:`derived_values`), name -> SI unit.
+    derived: ClassVar[Mapping[str, str]] = {}
     #: Parameter specifications by local name.
     parameters: ClassVar[Mapping[str, Param]] = {}
     #: Coordinates that hinge elements attached to this component act on.
@@ -55,7 +95,7 @@ class Component:
         **values: float | None,
     ) -> None:
         if not isinstance(name, str) or not name.isidentifier():
-            raise ValueError(
+            raise InputError(
                 f"{type(self).__name__} name must be an identifier such as `p1`, got {name!r}"
             )
         self.name = name
@@ -93,9 +133,38 @@ class Component:
         """All parameters with full dotted names, in declaration order."""
         return tuple(self.parameter(k) for k in self.parameters)
 
+    def coordinate_unit(self, local: str) -> str:
+        """SI unit of the coordinate ``local`` (e.g. ``"rad"`` for ``"theta"``)."""
+        return self.coordinate_units[local]
+
+    def derived_values(self, v: Mapping[str, Any], *, gravity: Any | None,
+                       hinge_stiffness: Any, hinge_damping: Any) -> dict[str, Any]:
+        """Quantities derived from the parameter values ``v`` (by local name), by the names
+        of :attr:`derived`.
+
+        Values may be floats, NumPy arrays (one entry per Monte Carlo draw) or CasADi
+        expressions (for delta-method standard errors), so implementations use arithmetic
+        and ``** 0.5`` only. ``gravity`` is the rig's uniform restoring acceleration (m/s^2,
+        ``None`` on rigs whose restoring field is not uniform gravity, such as a spinning
+        table); ``hinge_stiffness`` (N m/rad) and ``hinge_damping`` (N m s/rad) sum what the
+        attachments on this component's hinge add at small amplitude. A quantity whose
+        inputs are missing is left out.
+        """
+        return {}
+
+    def hinge_terms(self, v: Mapping[str, Any]) -> tuple[Any, Any]:
+        """Small-amplitude stiffness (N m/rad) and viscous damping (N m s/rad) this element
+        adds to its host's hinge, from its parameter values ``v`` by local name."""
+        return 0.0, 0.0
+
     def problems(self) -> list[str]:
-        """Problems of this component on its own (bounds, defaults)."""
+        """Problems of this component on its own (bounds, defaults, coordinate units)."""
         out = []
+        missing = [c for c in self.coordinates if c not in self.coordinate_units]
+        if missing:
+            out.append(f"{self.label}: no unit for coordinate(s) {', '.join(missing)}: declare "
+                       "`coordinate_units = {" + ", ".join(f'\"{c}\": \"m\"' for c in missing)
+                       + "}` (or \"rad\")")
         for local, (lo, hi) in self._bounds.items():
             spec = self.parameters[local]
             if not lo <= hi:
@@ -118,15 +187,13 @@ class Component:
     def structure(self) -> str:
         """A string that changes whenever the derived equations could change.
 
-        It holds the class, a hash of its source, the name and :meth:`_extra_structure`;
-        parameter values and bounds are left out because equations are symbolic in them.
+        It holds the class, a hash of the source of its MRO and their modules
+        (:func:`source_digest`), the name and :meth:`_extra_structure`; parameter values and
+        bounds are left out because equations are symbolic in them. Raises
+        :class:`SourceUnavailable` when a source cannot be read (then nothing may be cached).
         """
         cls = type(self)
-        try:
-            source = inspect.getsource(cls)
-        except (OSError, TypeError):
-            source = cls.__qualname__
-        digest = hashlib.sha256(source.encode()).hexdigest()[:16]
+        digest = source_digest(cls)
         return f"{cls.__module__}.{cls.__qualname__}[{digest}]({self.name};{self._extra_structure()})"
 
     def _extra_structure(self) -> str:
@@ -179,6 +246,12 @@ class Rig(Component):
         **values: float | None,
     ) -> None:
         super().__init__(name, bounds=bounds, **values)
+
+    def restoring_gravity(self, v: Mapping[str, Any]) -> Any | None:
+        """The uniform gravity (m/s^2) that restores pendulums on this rig, from its
+        parameter values ``v`` by local name; ``None`` when the tank frame rotates or
+        accelerates so that no single ``g`` sets the slosh frequencies."""
+        return None
 
     def declare(self, k: "Declaration") -> None:
         """Rigs add no generalized coordinates by default (the dry mass is added by

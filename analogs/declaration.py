@@ -13,6 +13,8 @@ from typing import Any
 import sympy as sp
 from sympy.physics import mechanics as me
 
+from .errors import InputError
+
 __all__ = ["Namespace", "Declaration", "FrameDeclaration", "PointMass", "Body"]
 
 
@@ -151,11 +153,11 @@ class FrameDeclaration(_Base):
         a signal that is not an input.
         """
         if derivatives not in (0, 1, 2):
-            raise ValueError(f"add_input derivatives must be 0, 1 or 2, got {derivatives!r}")
+            raise InputError(f"add_input derivatives must be 0, 1 or 2, got {derivatives!r}")
         name = f"{self._owner}.{local}"
         if derivative_of is not None:
             if derivatives:
-                raise ValueError("add_input(derivative_of=...) declares a single input; "
+                raise InputError("add_input(derivative_of=...) declares a single input; "
                                  "pass derivatives=0")
             sym = derivative_of.diff(self.t)
         else:

@@ -25,6 +25,9 @@ class HingeSpring(Attachment):
                  bounds: dict[str, tuple[float, float]] | None = None) -> None:
         super().__init__(host, bounds=bounds, stiffness=stiffness)
 
+    def hinge_terms(self, v):
+        return v.get("stiffness", 0.0), 0.0
+
     def declare(self, k: "Declaration") -> None:
         k.add_potential(sum(k.p.stiffness * a**2 / 2 for a in k.hinge))
 
@@ -40,6 +43,9 @@ class HingeDamper(Attachment):
     def __init__(self, host: str = "p1", *, damping: float | None = None,
                  bounds: dict[str, tuple[float, float]] | None = None) -> None:
         super().__init__(host, bounds=bounds, damping=damping)
+
+    def hinge_terms(self, v):
+        return 0.0, v.get("damping", 0.0)
 
     def declare(self, k: "Declaration") -> None:
         k.add_dissipation(sum(k.p.damping * r**2 / 2 for r in k.hinge_rates))
@@ -85,6 +91,9 @@ class DiaphragmSpring(Attachment):
                  bounds: dict[str, tuple[float, float]] | None = None) -> None:
         super().__init__(host, bounds=bounds, diaphragm_stiffness=diaphragm_stiffness,
                          diaphragm_damping=diaphragm_damping)
+
+    def hinge_terms(self, v):
+        return v.get("diaphragm_stiffness", 0.0), v.get("diaphragm_damping", 0.0)
 
     def declare(self, k: "Declaration") -> None:
         k.add_potential(sum(k.p.diaphragm_stiffness * a**2 / 2 for a in k.hinge))

@@ -4,14 +4,16 @@ from __future__ import annotations
 
 import hashlib
 from collections.abc import Iterable, Mapping
+from typing import Any
 
 from .component import Attachment, Component, Rig
+from .errors import InputError, UnknownNameError
 from .parameter import Parameter
 
 __all__ = ["Model", "ModelError"]
 
 
-class ModelError(ValueError):
+class ModelError(InputError):
     """A model declaration with problems; ``problems`` lists every one of them."""
 
     def __init__(self, problems: list[str]) -> None:
@@ -89,7 +91,7 @@ class Model:
         for c in self._components:
             if c.name == name and not isinstance(c, Attachment):
                 return c
-        raise KeyError(f"the model has no component {name!r}; it has {self.names}")
+        raise UnknownNameError(f"the model has no component {name!r}; it has {self.names}")
 
     @property
     def parameters(self) -> tuple[Parameter, ...]:
@@ -102,7 +104,7 @@ class Model:
         for p in self.parameters:
             if p.name == name:
                 return p
-        raise KeyError(
+        raise UnknownNameError(
             f"the model has no parameter {name!r}; its parameters are "
             + ", ".join(p.name for p in self.parameters)
         )
@@ -170,7 +172,7 @@ class Model:
         values = dict(values or {})
         unknown = sorted(set(values) - set(params))
         if unknown:
-            raise KeyError(
+            raise UnknownNameError(
                 f"unknown parameter{'s' if len(unknown) > 1 else ''} {', '.join(map(repr, unknown))}; "
                 f"the model's parameters are {', '.join(params)}"
             )
@@ -184,11 +186,55 @@ class Model:
                     bad.append(msg)
             out[name] = v
         if bad:
-            raise ValueError("; ".join(bad))
+            raise InputError("; ".join(bad))
+        return out
+
+    def coordinate_units(self) -> dict[str, str]:
+        """SI unit of every generalized coordinate by full name (``"p1.theta": "rad"``)."""
+        self.validate()
+        return {f"{c.prefix}.{q}": c.coordinate_unit(q)
+                for c in self._components if not isinstance(c, Attachment) for q in c.coordinates}
+
+    def derived_quantities(self, values: Mapping[str, Any]) -> dict[str, tuple[Any, str]]:
+        """Quantities the components derive from parameter ``values`` (by dotted name):
+        ``{"p1.frequency_hz": (value, "Hz"), ...}``.
+
+        Each component declares its own (:meth:`Component.derived_values`); attachments
+        contribute their small-amplitude hinge stiffness and damping to their host, and the
+        rig says which gravity restores pendulums. Values may be floats, NumPy arrays or
+        CasADi expressions; quantities whose inputs are missing (``None``) are left out.
+        """
+        def local(c: Component) -> dict[str, Any]:
+            out = {}
+            for k in c.parameters:
+                v = values.get(f"{c.prefix}.{k}")
+                if v is not None:
+                    out[k] = v
+            return out
+
+        rig = self.rig
+        gravity = rig.restoring_gravity(local(rig))
+        hinge: dict[str, list[Any]] = {}
+        for c in self._components:
+            if isinstance(c, Attachment):
+                k, d = c.hinge_terms(local(c))
+                acc = hinge.setdefault(c.host, [0.0, 0.0])
+                acc[0], acc[1] = acc[0] + k, acc[1] + d
+        out: dict[str, tuple[Any, str]] = {}
+        for c in self._components:
+            if isinstance(c, (Attachment, Rig)) or not c.derived:
+                continue
+            k, d = hinge.get(c.name, (0.0, 0.0))
+            for name, value in c.derived_values(local(c), gravity=gravity, hinge_stiffness=k,
+                                                hinge_damping=d).items():
+                out[f"{c.prefix}.{name}"] = (value, c.derived[name])
         return out
 
     def structure_key(self) -> str:
-        """Hash of the declaration: equal for models that derive to the same equations."""
+        """Hash of the declaration: equal for models that derive to the same equations.
+
+        Raises :class:`analogs.component.SourceUnavailable` when a component's source cannot
+        be read (such a model is derived without the cache)."""
         text = "|".join(c.structure() for c in self._components)
         return hashlib.sha256(text.encode()).hexdigest()
 

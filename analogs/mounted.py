@@ -5,6 +5,7 @@ from __future__ import annotations
 from typing import TYPE_CHECKING, Any
 
 from .component import Attachment, Component, Rig
+from .errors import InputError
 from .parameter import Param
 
 if TYPE_CHECKING:  # pragma: no cover
@@ -16,7 +17,8 @@ __all__ = ["Mounted", "MOUNT_AXES"]
 MOUNT_AXES = ("parallel", "inward")
 
 _MOUNT_PARAMS = {
-    "mount_radius": Param("m", 0.0, 0.0, description="distance of the component's tank origin from the z axis"),
+    "mount_radius": Param("m", 0.0, 0.0,
+                          description="distance of the component's tank origin from the z axis"),
     "mount_azimuth": Param("rad", 0.0, description="azimuth of the mount, from x toward y"),
     "mount_height": Param("m", 0.0, description="height of the component's tank origin along z"),
 }
@@ -57,14 +59,16 @@ class Mounted(Component):
                 f"Mounted wraps an analog component such as `SphericalPendulum('p1')`, got "
                 f"{component!r}; attach hinge elements to the mounted component by name")
         if axis not in MOUNT_AXES:
-            raise ValueError(
+            raise InputError(
                 f"Mounted axis must be one of {', '.join(map(repr, MOUNT_AXES))}, got {axis!r}")
         clash = sorted(set(component.parameters) & set(_MOUNT_PARAMS))
         if clash:
-            raise ValueError(f"{component.label} already has parameters {clash}")
+            raise InputError(f"{component.label} already has parameters {clash}")
         self.component = component
         self.axis = axis
         self.coordinates = component.coordinates
+        self.coordinate_units = component.coordinate_units
+        self.derived = component.derived
         self.hinge_angles = component.hinge_angles
         self.parameters = {**component.parameters, **_MOUNT_PARAMS}
         mount = {"mount_radius": mount_radius, "mount_azimuth": mount_azimuth,
@@ -81,6 +85,9 @@ class Mounted(Component):
 
     def problems(self) -> list[str]:
         return super().problems() + self.component.problems()
+
+    def derived_values(self, v, **context):
+        return self.component.derived_values(v, **context)
 
     def declare(self, k: "Declaration") -> None:
         import sympy as sp

@@ -2,10 +2,12 @@
 
 from __future__ import annotations
 
-from typing import TYPE_CHECKING, ClassVar
+import math
+from typing import TYPE_CHECKING
 
 from ._units import TINY_LENGTH, TINY_MASS
 from .component import Component
+from .errors import InputError
 from .parameter import Param
 
 if TYPE_CHECKING:  # pragma: no cover
@@ -21,6 +23,20 @@ _PENDULUM_PARAMS = {
 
 
 class _PendulumBase(Component):
+    derived = {"frequency_hz": "Hz", "damping_ratio": "-"}
+
+    def derived_values(self, v, *, gravity, hinge_stiffness, hinge_damping):
+        """Small-amplitude frequency ``sqrt(g/L + k/(m L^2)) / 2 pi`` (Hz) and damping
+        ratio ``c / (2 sqrt((m g L + k) m L^2))`` with ``k`` and ``c`` the hinge stiffness
+        and damping of the attachments; only under uniform gravity."""
+        m, L = v.get("mass"), v.get("length")
+        if gravity is None or m is None or L is None:
+            return {}
+        k, c = hinge_stiffness, hinge_damping
+        omega = (gravity / L + k / (m * L**2)) ** 0.5
+        return {"frequency_hz": omega / (2 * math.pi),
+                "damping_ratio": c / (2 * ((m * gravity * L + k) * m * L**2) ** 0.5)}
+
     def __init__(self, name: str, *, mass: float | None = None, length: float | None = None,
                  hinge_height: float | None = None,
                  bounds: dict[str, tuple[float, float]] | None = None) -> None:
@@ -36,6 +52,7 @@ class Pendulum(_PendulumBase):
     """
 
     coordinates = ("theta",)
+    coordinate_units = {"theta": "rad"}
     hinge_angles = ("theta",)
     parameters = _PENDULUM_PARAMS
 
@@ -44,7 +61,7 @@ class Pendulum(_PendulumBase):
                  plane: str = "xz",
                  bounds: dict[str, tuple[float, float]] | None = None) -> None:
         if plane not in ("xz", "yz"):
-            raise ValueError(f"Pendulum plane must be 'xz' or 'yz', got {plane!r}")
+            raise InputError(f"Pendulum plane must be 'xz' or 'yz', got {plane!r}")
         self.plane = plane
         super().__init__(name, mass=mass, length=length, hinge_height=hinge_height, bounds=bounds)
 
@@ -68,6 +85,7 @@ class SphericalPendulum(_PendulumBase):
     """
 
     coordinates = ("alpha", "beta")
+    coordinate_units = {"alpha": "rad", "beta": "rad"}
     hinge_angles = ("alpha", "beta")
     parameters = _PENDULUM_PARAMS
 

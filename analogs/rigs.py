@@ -6,6 +6,7 @@ import math
 from typing import TYPE_CHECKING
 
 from .component import Rig
+from .errors import InputError
 from .parameter import Param
 
 if TYPE_CHECKING:  # pragma: no cover
@@ -39,7 +40,7 @@ class LateralRig(Rig):
                  bounds: dict[str, tuple[float, float]] | None = None,
                  **values: float | None) -> None:
         if excitation not in ("measured", "crank"):
-            raise ValueError(
+            raise InputError(
                 f"LateralRig excitation must be 'measured' or 'crank', got {excitation!r}"
             )
         self.excitation = excitation
@@ -58,6 +59,9 @@ class LateralRig(Rig):
 
     def _extra_structure(self) -> str:
         return self.excitation
+
+    def restoring_gravity(self, v):
+        return v.get("gravity")
 
     def problems(self) -> list[str]:
         out = super().problems()

@@ -6,6 +6,7 @@ from typing import TYPE_CHECKING
 
 from ._units import TINY_INERTIA
 from .component import Component
+from .errors import InputError
 from .parameter import Param
 
 if TYPE_CHECKING:  # pragma: no cover
@@ -23,6 +24,7 @@ class Rotor(Component):
     """
 
     coordinates = ("psi",)
+    coordinate_units = {"psi": "rad"}
     parameters = {
         "inertia": Param("kg m^2", None, TINY_INERTIA, description="rotor inertia about its axis"),
         "damping": Param("N m s/rad", 0.0, 0.0, description="viscous coupling to the tank"),
@@ -32,7 +34,7 @@ class Rotor(Component):
                  damping: float | None = None, axis: str = "z",
                  bounds: dict[str, tuple[float, float]] | None = None) -> None:
         if axis not in ("x", "y", "z"):
-            raise ValueError(f"Rotor axis must be 'x', 'y' or 'z', got {axis!r}")
+            raise InputError(f"Rotor axis must be 'x', 'y' or 'z', got {axis!r}")
         self.axis = axis
         super().__init__(name, bounds=bounds, inertia=inertia, damping=damping)
 

@@ -13,6 +13,7 @@ import numpy as np
 
 from ._units import TINY_INERTIA, TINY_MASS
 from .component import Rig
+from .errors import InputError
 from .parameter import Param
 from .spinning import TANK_AXES
 
@@ -67,12 +68,13 @@ class FreeSpacecraft(Rig):
                  name: str = "bus", bounds: dict[str, tuple[float, float]] | None = None,
                  **values: float | None) -> None:
         if tank_axis not in TANK_AXES:
-            raise ValueError(
+            raise InputError(
                 f"FreeSpacecraft tank_axis must be one of {', '.join(map(repr, TANK_AXES))}, "
                 f"got {tank_axis!r}")
         self.translation = bool(translation)
         self.tank_axis = tank_axis
         self.coordinates = (("x", "y", "z") if self.translation else ()) + ("phi", "theta", "psi")
+        self.coordinate_units = {c: "m" if c in "xyz" else "rad" for c in self.coordinates}
         self.parameters = {
             "spin_rate": Param("rad/s", None, description="nominal spin rate about the bus z axis"),
             "mass": Param("kg", None, TINY_MASS, description="bus mass (without modelled liquid)"),
@@ -81,7 +83,8 @@ class FreeSpacecraft(Rig):
             "inertia_z": Param("kg m^2", None, TINY_INERTIA,
                                description="bus central inertia about the spin axis z"),
             "radius": Param("m", 0.0, 0.0, description="tank origin's distance from the bus z axis, along x"),
-            "height": Param("m", 0.0, description="tank origin's height along z above the bus centre of mass"),
+            "height": Param("m", 0.0,
+                            description="tank origin's height along z above the bus centre of mass"),
         }
         super().__init__(name, bounds=bounds, **values)
 

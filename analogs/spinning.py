@@ -6,6 +6,7 @@ import math
 from typing import TYPE_CHECKING
 
 from .component import Rig
+from .errors import InputError
 from .parameter import Param
 
 if TYPE_CHECKING:  # pragma: no cover
@@ -76,7 +77,7 @@ class SpinningRig(Rig):
                  bounds: dict[str, tuple[float, float]] | None = None,
                  **values: float | None) -> None:
         if tank_axis not in TANK_AXES:
-            raise ValueError(
+            raise InputError(
                 f"SpinningRig tank_axis must be one of {', '.join(map(repr, TANK_AXES))}, "
                 f"got {tank_axis!r}")
         if not isinstance(gravity, bool):
@@ -98,7 +99,8 @@ class SpinningRig(Rig):
                                                     "the vertical (positive: with the spin)"),
         }
         if gravity:
-            params["gravity"] = Param("m/s^2", 9.80665, 0.0, description="gravity along -z of the inertial frame")
+            params["gravity"] = Param("m/s^2", 9.80665, 0.0,
+                                      description="gravity along -z of the inertial frame")
         self.parameters = params
         super().__init__(name, bounds=bounds, **values)
 

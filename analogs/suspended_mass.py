@@ -2,10 +2,12 @@
 
 from __future__ import annotations
 
+import math
 from typing import TYPE_CHECKING
 
 from ._units import TINY_MASS
 from .component import Component
+from .errors import InputError
 from .parameter import Param
 
 if TYPE_CHECKING:  # pragma: no cover
@@ -24,9 +26,12 @@ class SuspendedMass(Component):
                  bounds: dict[str, tuple[float, float]] | None = None,
                  **values: float | None) -> None:
         if not axes or any(a not in "xyz" for a in axes) or len(set(axes)) != len(axes):
-            raise ValueError(f"SuspendedMass axes must be distinct letters of 'xyz', got {axes!r}")
+            raise InputError(f"SuspendedMass axes must be distinct letters of 'xyz', got {axes!r}")
         self.axes = axes
         self.coordinates = tuple(f"s_{a}" for a in axes)
+        self.coordinate_units = {f"s_{a}": "m" for a in axes}
+        self.derived = {f"{q}_{a}": u for a in axes
+                        for q, u in (("frequency_hz", "Hz"), ("damping_ratio", "-"))}
         params = {
             "mass": Param("kg", None, TINY_MASS, description="suspended mass"),
             "height": Param("m", None, description="rest height above the tank origin"),
@@ -39,6 +44,18 @@ class SuspendedMass(Component):
 
     def _extra_structure(self) -> str:
         return self.axes
+
+    def derived_values(self, v, *, gravity, hinge_stiffness, hinge_damping):
+        """Per axis: ``sqrt(k/m) / 2 pi`` (Hz) and ``c / (2 sqrt(k m))``."""
+        out = {}
+        m = v.get("mass")
+        for a in self.axes:
+            k, c = v.get(f"stiffness_{a}"), v.get(f"damping_{a}", 0.0)
+            if m is None or k is None:
+                continue
+            out[f"frequency_hz_{a}"] = (k / m) ** 0.5 / (2 * math.pi)
+            out[f"damping_ratio_{a}"] = c / (2 * (k * m) ** 0.5)
+        return out
 
     def declare(self, k: "Declaration") -> None:
         T, p = k.tank, k.p

@@ -5,8 +5,8 @@ import os
 for _var in ("OMP_NUM_THREADS", "OPENBLAS_NUM_THREADS", "MKL_NUM_THREADS", "NUMEXPR_NUM_THREADS"):
     os.environ[_var] = "1"
 
-import statistics  # noqa: E402
-import time  # noqa: E402
+import statistics
+import time
 
 
 def median_time(fn, *, repeat: int = 20, warmup: int = 2) -> float:

@@ -17,9 +17,10 @@ ROOT = Path(__file__).resolve().parents[1]
 sys.path.insert(0, str(ROOT))
 sys.path.insert(0, str(ROOT / "tests"))
 
-import reference_models as ref  # noqa: E402
-from estimate import diagnose, load_case  # noqa: E402
-from synthetic_cases import G, make_case, pendulum  # noqa: E402
+import reference_models as ref
+from synthetic_cases import G, make_case, pendulum
+
+from estimate import diagnose, load_case
 
 
 def main(repeat: int = 3) -> None:

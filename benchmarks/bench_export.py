@@ -25,9 +25,9 @@ from _common import median_time
 ROOT = Path(__file__).resolve().parents[1]
 sys.path.insert(0, str(ROOT))
 
-from analogs import FixedMass, HingeDamper, HingeSpring, LateralRig, Pendulum  # noqa: E402
-from derive import RK4, Sine, derive, simulate  # noqa: E402
-from derive.export_c import CFLAGS, export_c  # noqa: E402
+from analogs import FixedMass, HingeDamper, HingeSpring, LateralRig, Pendulum
+from derive import RK4, Sine, derive, simulate
+from derive.export_c import CFLAGS, export_c
 
 PARAMS = {"rig.dry_mass": 1.2, "fixed.mass": 1.456, "p1.mass": 1.338, "p1.length": 0.057,
           "p1.stiffness": 0.01, "p1.damping": 2e-4, "p2.mass": 0.048, "p2.length": 0.018,
@@ -109,11 +109,11 @@ def bench_c() -> dict:
 
 
 def bench_montecarlo(draws: int, dask: bool) -> dict:
-    from estimate.case import load_case
+    from estimate.analysis.montecarlo import Fit, monte_carlo
+    from estimate.data import load_case
+    from estimate.data.experiment import experiment
+    from estimate.data.models import model_from_spec
     from estimate.executor import DaskExecutor, LocalExecutor
-    from estimate.experiment import experiment
-    from estimate.models import model_from_spec
-    from estimate.montecarlo import Fit, monte_carlo
 
     case = load_case(ROOT / "examples" / "A1.toml")
     exp = experiment(case, model_from_spec("fixed,p1", case))
@@ -123,8 +123,11 @@ def bench_montecarlo(draws: int, dask: bool) -> dict:
     fit = Fit(path=None, model_spec="fixed,p1", case=str(case.path), values=values,
               units={}, lower={n: 1e-9 for n in names}, upper={n: np.inf for n in names},
               estimated=names, covariance_names=names, covariance=np.diag(sd**2))
-    run = lambda ex, n: monte_carlo(exp.derived, case.time, exp.excitation, fit, n,  # noqa: E731
-                                    fixed=exp.fixed, seed=0, executor=ex)
+
+    def run(ex, n):
+        return monte_carlo(exp.derived, case.time, exp.excitation, fit, n, fixed=exp.fixed,
+                           seed=0, executor=ex)
+
     run(LocalExecutor(), 256)  # compile once (disk cache)
     out = {}
     res = run(LocalExecutor(), draws)

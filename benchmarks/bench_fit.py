@@ -22,8 +22,8 @@ from scipy.optimize import least_squares
 ROOT = Path(__file__).resolve().parents[1]
 sys.path.insert(0, str(ROOT))
 
-from estimate import Collocation, FitProblem, MultipleShooting, fit, load_case, model_from_spec  # noqa: E402
-from estimate.signals import displacement_derivatives, lowpass  # noqa: E402
+from estimate import Collocation, FitProblem, MultipleShooting, fit, load_case, model_from_spec
+from estimate.data.signals import displacement_derivatives, lowpass
 
 CASE = ROOT / "examples" / "A1.toml"
 NAMES = ("fixed.mass", "p1.mass", "p1.length", "p1.damping", "p1.stiffness")
@@ -50,7 +50,8 @@ def scipy_fit(case, start, bounds):
         def rhs(tt, y):
             a = acc(tt)
             th, thd = y
-            return [thd, -(m * L * a * math.cos(th) + m * g * L * math.sin(th) + k * th + c * thd) / (m * L**2)]
+            torque = m * L * a * math.cos(th) + m * g * L * math.sin(th) + k * th + c * thd
+            return [thd, -torque / (m * L**2)]
 
         sol = solve_ivp(rhs, (t[0], t[-1]), [0.0, 0.0], t_eval=t, rtol=1e-8, atol=1e-10)
         th, thd = sol.y

@@ -8,10 +8,10 @@ import os
 for _var in ("OMP_NUM_THREADS", "OPENBLAS_NUM_THREADS", "MKL_NUM_THREADS"):
     os.environ[_var] = "1"  # oversubscription made such solvers 10x slower here
 
-import statistics  # noqa: E402
-import time  # noqa: E402
+import statistics
+import time
 
-from analogs.tank import Sphere, predict  # noqa: E402
+from analogs.tank import Sphere, predict
 
 TARGET = 0.2  # s
 

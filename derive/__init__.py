@@ -8,8 +8,8 @@ Public API::
 
 from ._derive import derive
 from .derived import OUTPUT_NAMES, OUTPUT_UNITS, DerivedModel, ParameterError
-from .export_c import CExport, export_c
 from .excitation import Excitation, NoExcitation, Sampled, Sine
+from .export_c import CExport, export_c
 from .simulate import RK4, Adaptive, Simulation, rk4_step, simulate
 
 __all__ = [
@@ -33,7 +33,7 @@ __all__ = [
 ]
 
 
-def export_fmu(*args, **kwargs):  # noqa: D103 - documented in derive.fmu
+def export_fmu(*args, **kwargs):
     from .fmu import export_fmu as _export_fmu
 
     return _export_fmu(*args, **kwargs)

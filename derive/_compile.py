@@ -1,8 +1,12 @@
 """Compile CasADi functions to shared libraries with the system C compiler, cached on disk.
 
 Generated C is keyed by a hash of the serialized function, so a library is built once per
-function and reused across processes. When no compiler is available the CasADi virtual
-machine function is returned unchanged, with a warning.
+function and reused across processes. The SHA-256 of every library is stored beside it
+(``<lib>.sha256``) and checked before the library is loaded: a truncated or altered library
+is rebuilt (with a warning), never loaded. Libraries live in the private cache folder
+(:func:`derive.cache.ensure_private_dir`) and one writable by others is refused. When no
+compiler is available the CasADi virtual machine function is returned unchanged, with a
+warning.
 """
 
 from __future__ import annotations
@@ -10,6 +14,7 @@ from __future__ import annotations
 import hashlib
 import os
 import shutil
+import stat
 import subprocess
 import tempfile
 import warnings
@@ -17,7 +22,7 @@ from pathlib import Path
 
 import casadi as ca
 
-from .cache import cache_dir
+from .cache import cache_dir, ensure_private_dir
 
 __all__ = ["compiled", "c_compiler"]
 
@@ -32,20 +37,42 @@ def c_compiler() -> str | None:
     return None
 
 
+def _file_digest(path: Path) -> str:
+    return hashlib.sha256(path.read_bytes()).hexdigest()
+
+
+def _trusted(lib: Path) -> bool:
+    """The library exists, is not writable by others and matches its stored hash."""
+    stamp = lib.with_name(lib.name + ".sha256")
+    if not lib.exists():
+        return False
+    if lib.stat().st_mode & (stat.S_IWGRP | stat.S_IWOTH):
+        warnings.warn(f"{lib} is writable by other users; rebuilding it", RuntimeWarning,
+                      stacklevel=4)
+        return False
+    try:
+        ok = stamp.read_text().strip() == _file_digest(lib)
+    except OSError:
+        ok = False
+    if not ok:
+        warnings.warn(f"compiled library {lib} does not match its stored hash (truncated or "
+                      "altered); rebuilding it", RuntimeWarning, stacklevel=4)
+    return ok
+
+
 def compiled(fn: ca.Function) -> ca.Function:
     """``fn`` compiled to native code (``-O2``), or ``fn`` itself without a compiler."""
     key = hashlib.sha256(fn.serialize().encode()).hexdigest()[:24]
     if key in _LOADED:
         return _LOADED[key]
-    folder = cache_dir() / "compiled"
+    folder = ensure_private_dir(cache_dir() / "compiled")
     lib = folder / f"{fn.name()}_{key}.so"
-    if not lib.exists():
+    if not _trusted(lib):
         cc = c_compiler()
         if cc is None:
             warnings.warn("no C compiler found: using CasADi's virtual machine", RuntimeWarning,
                           stacklevel=3)
             return fn
-        folder.mkdir(parents=True, exist_ok=True)
         with tempfile.TemporaryDirectory(dir=folder) as tmp:
             src = f"{fn.name()}_{key}.c"
             gen = ca.CodeGenerator(src, {"with_header": False})
@@ -58,7 +85,12 @@ def compiled(fn: ca.Function) -> ca.Function:
                 warnings.warn(f"compiling {fn.name()} failed, using CasADi's virtual machine:\n"
                               f"{proc.stderr[-2000:]}", RuntimeWarning, stacklevel=3)
                 return fn
+            stamp = Path(tmp) / (lib.name + ".sha256")
+            stamp.write_text(_file_digest(out))
+            # the library first, then its hash: a reader between the two sees a mismatch
+            # and rebuilds instead of loading a library without a matching hash
             os.replace(out, lib)
+            os.replace(stamp, lib.with_name(lib.name + ".sha256"))
     ext = ca.external(fn.name(), str(lib))
     _LOADED[key] = ext
     return ext

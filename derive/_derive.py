@@ -2,6 +2,9 @@
 
 from __future__ import annotations
 
+import warnings
+
+from analogs.component import SourceUnavailable
 from analogs.model import Model
 
 from . import cache
@@ -22,7 +25,9 @@ def derive(model: Model, *, use_cache: bool = True) -> DerivedModel:
     model : analogs.Model
         A validated model (one rig plus components).
     use_cache : bool, default True
-        Read and write the on-disk cache (see :mod:`derive.cache`).
+        Read and write the on-disk cache (see :mod:`derive.cache`). A model whose component
+        source cannot be read (a class made with ``exec``) is always derived anew, with a
+        warning once per class.
 
     Examples
     --------
@@ -33,8 +38,13 @@ def derive(model: Model, *, use_cache: bool = True) -> DerivedModel:
     ('p1.theta',)
     """
     model.validate()
-    key = cache.cache_key(model.structure_key())
-    hit = cache.load(key) if use_cache else None
+    key = None
+    if use_cache:
+        try:
+            key = cache.cache_key(model.structure_key())
+        except SourceUnavailable as err:
+            _warn_uncached(err)
+    hit = cache.load(key) if key is not None else None
     if hit is not None:
         fns, meta = hit
         from_cache = True
@@ -52,7 +62,7 @@ def derive(model: Model, *, use_cache: bool = True) -> DerivedModel:
             "measured": list(sym.measured),
             "dependencies": dependencies(fns, sym.parameters),
         }
-        if use_cache:
+        if key is not None:
             cache.store(key, fns, meta)
         from_cache = False
     return DerivedModel(
@@ -69,3 +79,14 @@ def derive(model: Model, *, use_cache: bool = True) -> DerivedModel:
         dependencies={k: tuple(v) for k, v in meta["dependencies"].items()},
         from_cache=from_cache,
     )
+
+
+_WARNED: set[tuple[str, int]] = set()
+
+
+def _warn_uncached(err: SourceUnavailable) -> None:
+    tag = (err.cls.__qualname__, id(err.cls))
+    if tag not in _WARNED:
+        _WARNED.add(tag)
+        warnings.warn(f"{err}; its equations are derived without the on-disk cache",
+                      RuntimeWarning, stacklevel=3)

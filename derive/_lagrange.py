@@ -13,7 +13,14 @@ from sympy.core.function import AppliedUndef
 from sympy.physics import mechanics as me
 
 from analogs.component import Attachment, Rig
-from analogs.declaration import Declaration, FrameDeclaration, Namespace, _Collected, _Shared
+from analogs.declaration import (
+    Declaration,
+    FrameDeclaration,
+    Namespace,
+    _Collected,
+    _Shared,
+)
+from analogs.errors import InputError
 from analogs.model import Model
 
 from .derived import OUTPUT_NAMES
@@ -154,7 +161,7 @@ def assemble(model: Model) -> SymbolicModel:
     if left:
         named = {u: sp.Symbol(nm) for u, nm in zip(usyms, inputs)}
         left = sorted(str(e.xreplace(named)) for e in left)
-        raise ValueError(
+        raise InputError(
             f"the equations of {model!r} need {', '.join(left)}, which no "
             "input supplies; declare more derivatives with `add_input(..., derivatives=...)`")
     names = tuple(p.name for p in model.parameters)

@@ -1,23 +1,33 @@
-"""On-disk cache of derived models, keyed by a hash of the declaration.
+"""On-disk cache of derived models, keyed by everything that can change the equations.
 
-A cache hit loads serialized CasADi functions and metadata and imports no SymPy.
-The folder is ``$SLOSH_CACHE_DIR`` or ``~/.cache/slosh-analogs``.
+A key holds the model's structure (component classes with the source of their MRO and
+modules, names, options; :meth:`analogs.Model.structure_key`), the source of the derivation
+code (every module of the ``analogs`` and ``derive`` packages), the package version and the
+SymPy and CasADi versions. A model whose source cannot be read is derived without the cache.
+
+Entries are JSON files holding serialized CasADi functions, metadata and a SHA-256 of both;
+a truncated, empty or altered entry fails the check and is rebuilt. Entries are written to a
+temporary file in the cache folder and renamed into place, so concurrent writers never leave
+a half-written entry. A cache hit imports no SymPy. The folder is ``$SLOSH_CACHE_DIR`` or
+``~/.cache/slosh-analogs``, created private to the user (mode 0700).
 """
 
 from __future__ import annotations
 
+import functools
 import hashlib
 import json
 import os
+import stat
 import tempfile
+import warnings
+from importlib import metadata
 from pathlib import Path
 
 import casadi as ca
 
-__all__ = ["cache_dir", "cache_key", "load", "store"]
+__all__ = ["cache_dir", "cache_key", "ensure_private_dir", "load", "store"]
 
-#: Bump when the derivation changes in a way the declaration hash cannot see.
-_FORMAT = 1
 _FUNCTIONS = ("rhs", "outputs", "mass_matrix", "forcing")
 
 
@@ -27,31 +37,88 @@ def cache_dir() -> Path:
     return Path(env) if env else Path.home() / ".cache" / "slosh-analogs"
 
 
+def ensure_private_dir(folder: Path) -> Path:
+    """Create ``folder`` (mode 0700) if needed and check that nobody else can write to it.
+
+    Raises ``PermissionError`` for a folder writable by group or others: native code and
+    serialized functions are loaded from it."""
+    folder.mkdir(mode=0o700, parents=True, exist_ok=True)
+    mode = folder.stat().st_mode
+    if mode & (stat.S_IWGRP | stat.S_IWOTH):
+        raise PermissionError(
+            f"the derivation cache folder {folder} is writable by other users (mode "
+            f"{stat.S_IMODE(mode):o}); run `chmod go-w {folder}` or set SLOSH_CACHE_DIR to a "
+            "private folder")
+    return folder
+
+
+def _version(dist: str) -> str:
+    try:
+        return metadata.version(dist)
+    except metadata.PackageNotFoundError:
+        return "unknown"
+
+
+@functools.cache
+def _code_digest() -> str:
+    """Hash of every module of the ``analogs`` and ``derive`` packages (the declaration API,
+    Lagrange's method, the CasADi translation) and of the versions that shape the result."""
+    import analogs
+
+    h = hashlib.sha256()
+    for package in (Path(analogs.__file__).parent, Path(__file__).parent):
+        for path in sorted(package.glob("*.py")):
+            h.update(path.name.encode())
+            h.update(path.read_bytes())
+    for dist in ("slosh-analogs", "sympy"):
+        h.update(f"{dist}={_version(dist)}".encode())
+    h.update(f"casadi={ca.__version__}".encode())
+    return h.hexdigest()
+
+
 def cache_key(structure_key: str) -> str:
-    """Key of a model structure for this derivation format and CasADi version."""
-    text = f"{structure_key}|format={_FORMAT}|casadi={ca.__version__}"
+    """Key of a model structure for this derivation code and these library versions."""
+    text = f"{structure_key}|code={_code_digest()}"
     return hashlib.sha256(text.encode()).hexdigest()[:32]
 
 
+def _checksum(meta: dict, functions: dict[str, str]) -> str:
+    text = json.dumps({"meta": meta, "functions": functions}, sort_keys=True)
+    return hashlib.sha256(text.encode()).hexdigest()
+
+
 def load(key: str) -> tuple[dict[str, ca.Function], dict] | None:
-    """Functions and metadata stored under ``key``, or ``None``."""
+    """Functions and metadata stored under ``key``, or ``None`` when there is no entry or it
+    fails its checksum (the caller then derives anew and overwrites it)."""
     path = cache_dir() / f"{key}.json"
+    if not path.exists():
+        return None
     try:
         data = json.loads(path.read_text())
+        if data.get("sha256") != _checksum(data["meta"], data["functions"]):
+            raise ValueError("checksum mismatch")
         fns = {name: ca.Function.deserialize(data["functions"][name]) for name in _FUNCTIONS}
-    except (OSError, ValueError, KeyError, RuntimeError):
+    except (OSError, ValueError, KeyError, TypeError, AttributeError, RuntimeError) as err:
+        warnings.warn(f"derivation cache entry {path} is damaged ({err}); deriving anew",
+                      RuntimeWarning, stacklevel=3)
         return None
     return fns, data["meta"]
 
 
 def store(key: str, functions: dict[str, ca.Function], meta: dict) -> Path:
     """Write functions and metadata atomically; return the file path."""
-    folder = cache_dir()
-    folder.mkdir(parents=True, exist_ok=True)
-    data = {"meta": meta, "functions": {n: functions[n].serialize() for n in _FUNCTIONS}}
+    folder = ensure_private_dir(cache_dir())
+    serialized = {n: functions[n].serialize() for n in _FUNCTIONS}
+    data = {"meta": meta, "functions": serialized, "sha256": _checksum(meta, serialized)}
     fd, tmp = tempfile.mkstemp(dir=folder, suffix=".tmp")
-    with os.fdopen(fd, "w") as fh:
-        json.dump(data, fh)
-    path = folder / f"{key}.json"
-    os.replace(tmp, path)
+    try:
+        with os.fdopen(fd, "w") as fh:
+            json.dump(data, fh)
+            fh.flush()
+            os.fsync(fh.fileno())
+        path = folder / f"{key}.json"
+        os.replace(tmp, path)
+    except BaseException:
+        Path(tmp).unlink(missing_ok=True)
+        raise
     return path

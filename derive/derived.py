@@ -10,6 +10,7 @@ from functools import cached_property
 import casadi as ca
 import numpy as np
 
+from analogs.errors import InputError, UnknownNameError
 from analogs.model import Model
 from analogs.parameter import Parameter
 
@@ -22,7 +23,7 @@ OUTPUT_NAMES = (
 OUTPUT_UNITS = ("N", "N", "N", "N m", "N m", "N m", "J", "J")
 
 
-class ParameterError(ValueError):
+class ParameterError(InputError):
     """Parameter values that are unknown to the model, missing, or out of bounds."""
 
 
@@ -58,6 +59,14 @@ class DerivedModel:
     def states(self) -> tuple[str, ...]:
         """State names: coordinates then ``<coordinate>_dot``."""
         return self.coordinates + tuple(f"{c}_dot" for c in self.coordinates)
+
+    @cached_property
+    def state_units(self) -> tuple[str, ...]:
+        """SI units of the states, as the components declare them (``rad``, ``m``, then
+        ``rad/s``, ``m/s``)."""
+        units = self.model.coordinate_units()
+        base = tuple(units[c] for c in self.coordinates)
+        return base + tuple(f"{u}/s" for u in base)
 
     @property
     def nx(self) -> int:
@@ -134,4 +143,4 @@ class DerivedModel:
         try:
             return OUTPUT_NAMES.index(name)
         except ValueError:
-            raise KeyError(f"no output {name!r}; outputs are {', '.join(OUTPUT_NAMES)}") from None
+            raise UnknownNameError(f"no output {name!r}; outputs are {', '.join(OUTPUT_NAMES)}") from None

@@ -13,6 +13,8 @@ from functools import cached_property
 import casadi as ca
 import numpy as np
 
+from analogs.errors import InputError
+
 __all__ = ["Excitation", "NoExcitation", "Sine", "Sampled"]
 
 
@@ -92,14 +94,14 @@ class Sampled(Excitation):
         t = np.asarray(self.time, float)
         s = np.atleast_2d(np.asarray(self.signals, float))
         if t.ndim != 1 or t.size < 4 or np.any(np.diff(t) <= 0):
-            raise ValueError("Sampled.time must be a strictly increasing 1-D array of >= 4 samples")
+            raise InputError("Sampled.time must be a strictly increasing 1-D array of >= 4 samples")
         if s.shape[1] != t.size or s.shape[0] % 3:
-            raise ValueError(
+            raise InputError(
                 f"Sampled.signals must have shape (3k, {t.size}) (value, rate, acceleration "
                 f"per signal), got {s.shape}"
             )
         if not np.all(np.isfinite(s)):
-            raise ValueError("Sampled.signals contain NaN or inf")
+            raise InputError("Sampled.signals contain NaN or inf")
         object.__setattr__(self, "time", t)
         object.__setattr__(self, "signals", s)
         object.__setattr__(self, "size", s.shape[0])
@@ -112,7 +114,7 @@ class Sampled(Excitation):
         t = np.asarray(t, float)
         lo, hi = self.time[0], self.time[-1]
         if t.size and (t.min() < lo - 1e-9 or t.max() > hi + 1e-9):
-            raise ValueError(
+            raise InputError(
                 f"excitation samples cover [{lo}, {hi}] s; requested [{t.min()}, {t.max()}] s"
             )
         return np.asarray(self._interpolant.map(t.size)(t.reshape(1, -1)))

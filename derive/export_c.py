@@ -22,6 +22,7 @@ from pathlib import Path
 import casadi as ca
 import numpy as np
 
+from analogs.errors import InputError
 from analogs.model import Model
 
 from ._c_templates import DRIVER, HEADER, MAKEFILE, WRAPPER
@@ -35,14 +36,9 @@ __all__ = ["CExport", "CFLAGS", "c_functions", "export_c", "has_c_compiler", "ru
 #: Flags the exported code is guaranteed to compile cleanly with.
 CFLAGS = ("-std=c99", "-Wall", "-Wextra", "-O2")
 
-_ANGLES = {"theta", "alpha", "beta", "psi", "phi"}
-
-
 def state_units(dm: DerivedModel) -> tuple[str, ...]:
-    """Units of the states: rad for angles (``theta``, ``alpha``, ``beta``, ``psi``), m for
-    displacements, then the same per second for the rates."""
-    base = tuple("rad" if c.rsplit(".", 1)[-1] in _ANGLES else "m" for c in dm.coordinates)
-    return base + tuple(f"{u}/s" for u in base)
+    """Units of the states as the components declare them (:attr:`DerivedModel.state_units`)."""
+    return dm.state_units
 
 
 def c_functions(dm: DerivedModel, *, substeps: int = 1, name: str = "slosh_model"
@@ -118,7 +114,7 @@ class CExport:
 
 def _c_name(name: str) -> str:
     if not re.fullmatch(r"[A-Za-z_][A-Za-z0-9_]*", name):
-        raise ValueError(f"name must be a C identifier (letters, digits, underscores), got {name!r}")
+        raise InputError(f"name must be a C identifier (letters, digits, underscores), got {name!r}")
     return name
 
 
@@ -214,7 +210,7 @@ def export_c(
     dm = model
     name = _c_name(name)
     if int(substeps) != substeps or substeps < 1:
-        raise ValueError(f"substeps must be a positive integer, got {substeps!r}")
+        raise InputError(f"substeps must be a positive integer, got {substeps!r}")
     folder = Path(folder).resolve()
     folder.mkdir(parents=True, exist_ok=True)
     files = {k: folder / f for k, f in {
@@ -282,7 +278,8 @@ def write_input_csv(path: str | os.PathLike, time: np.ndarray, inputs: np.ndarra
                     names: tuple[str, ...]) -> Path:
     """Write ``time`` (n,) and ``inputs`` (n, nu) as the driver's input CSV (full precision)."""
     path = Path(path)
-    data = np.column_stack([np.asarray(time, float).ravel(), np.asarray(inputs, float).reshape(len(time), -1)])
+    data = np.column_stack([np.asarray(time, float).ravel(),
+                            np.asarray(inputs, float).reshape(len(time), -1)])
     np.savetxt(path, data, delimiter=",", header=",".join(("time", *names)), comments="",
                fmt="%.17g")
     return path

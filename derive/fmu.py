@@ -20,6 +20,7 @@ from collections.abc import Mapping
 from pathlib import Path
 from xml.sax.saxutils import quoteattr
 
+from analogs.errors import InputError, MissingDependency
 from analogs.model import Model
 
 from ._compile import c_compiler
@@ -41,8 +42,9 @@ def fmi_headers() -> Path:
     try:
         import fmpy
     except ImportError as err:  # pragma: no cover - depends on the environment
-        raise ImportError("FMU export needs FMPy for the FMI headers: "
-                          "`pip install 'slosh-analogs[fmu]'` (or `pip install fmpy`)") from err
+        raise MissingDependency("FMU export needs FMPy for the FMI headers: "
+                                "`python3 -m pip install '.[fmu]'` (from a checkout) or "
+                                "`python3 -m pip install fmpy`") from err
     return Path(fmpy.__file__).parent / "c-code"
 
 
@@ -107,11 +109,11 @@ def export_fmu(
     dm = model
     path = Path(path)
     if path.suffix != ".fmu":
-        raise ValueError(f"the FMU file name must end in .fmu, got {path.name!r}")
+        raise InputError(f"the FMU file name must end in .fmu, got {path.name!r}")
     if path.exists() and not overwrite:
         raise FileExistsError(f"{path} exists; pass overwrite=True (`--overwrite`) to replace it")
     if not max_step > 0:
-        raise ValueError(f"max_step must be positive (s), got {max_step!r}")
+        raise InputError(f"max_step must be positive (s), got {max_step!r}")
     headers = fmi_headers()
     cc = cc or c_compiler()
     if cc is None:

@@ -8,6 +8,7 @@ from dataclasses import dataclass, field
 import casadi as ca
 import numpy as np
 
+from analogs.errors import InputError, UnknownNameError
 from analogs.model import Model
 
 from .derived import OUTPUT_NAMES, DerivedModel
@@ -31,7 +32,7 @@ class RK4:
 
     def __post_init__(self) -> None:
         if int(self.substeps) != self.substeps or self.substeps < 1:
-            raise ValueError(f"RK4.substeps must be a positive integer, got {self.substeps!r}")
+            raise InputError(f"RK4.substeps must be a positive integer, got {self.substeps!r}")
 
 
 @dataclass(frozen=True)
@@ -65,13 +66,13 @@ class Simulation:
     def output(self, name: str) -> np.ndarray:
         """One output channel (e.g. ``"force_x"``) on the time grid."""
         if name not in self.output_names:
-            raise KeyError(f"no output {name!r}; outputs are {', '.join(self.output_names)}")
+            raise UnknownNameError(f"no output {name!r}; outputs are {', '.join(self.output_names)}")
         return self.outputs[:, self.output_names.index(name)]
 
     def state(self, name: str) -> np.ndarray:
         """One state (e.g. ``"p1.theta"`` or ``"p1.theta_dot"``) on the time grid."""
         if name not in self.state_names:
-            raise KeyError(f"no state {name!r}; states are {', '.join(self.state_names)}")
+            raise UnknownNameError(f"no state {name!r}; states are {', '.join(self.state_names)}")
         return self.states[:, self.state_names.index(name)]
 
 
@@ -160,11 +161,11 @@ def _initial_state(dm: DerivedModel, x0) -> np.ndarray:
     if isinstance(x0, Mapping):
         unknown = sorted(set(x0) - set(dm.states))
         if unknown:
-            raise KeyError(f"unknown state {unknown}; states are {', '.join(dm.states)}")
+            raise UnknownNameError(f"unknown state {unknown}; states are {', '.join(dm.states)}")
         return np.array([float(x0.get(s, 0.0)) for s in dm.states])
     arr = np.asarray(x0, float).ravel()
     if arr.size != dm.nx:
-        raise ValueError(f"x0 must have {dm.nx} values ({', '.join(dm.states)}), got {arr.size}")
+        raise InputError(f"x0 must have {dm.nx} values ({', '.join(dm.states)}), got {arr.size}")
     return arr
 
 
@@ -218,10 +219,10 @@ def simulate(
     dm = model
     t = np.asarray(t, float).ravel()
     if t.size < 2 or np.any(np.diff(t) <= 0):
-        raise ValueError("t must be a strictly increasing array of at least 2 times (s)")
+        raise InputError("t must be a strictly increasing array of at least 2 times (s)")
     exc = excitation if excitation is not None else NoExcitation(size=dm.nu)
     if exc.size != dm.nu:
-        raise ValueError(
+        raise InputError(
             f"the excitation supplies {exc.size} input values but the model takes {dm.nu} "
             f"({', '.join(dm.inputs) or 'none'})"
         )

@@ -8,9 +8,9 @@ import os
 for _var in ("OMP_NUM_THREADS", "OPENBLAS_NUM_THREADS", "MKL_NUM_THREADS"):
     os.environ.setdefault(_var, "1")
 
-from pathlib import Path  # noqa: E402
+from pathlib import Path
 
-from analogs.tank import Liquid, Sphere, predict  # noqa: E402
+from analogs.tank import Liquid, Sphere, predict
 
 R = 0.1016
 WATER = Liquid(998.2, 0.893e-6, "water")

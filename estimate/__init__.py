@@ -1,5 +1,13 @@
-"""Estimation of analog parameters from tank-test data: case files, signal processing,
-the NLP (multiple shooting or collocation, IPOPT), uncertainties, diagnosis, reports.
+"""Estimation of analog parameters from tank-test data, by stage:
+
+* :mod:`estimate.data` - case files (TOML + CSV), signal processing, experiments;
+* :mod:`estimate.fitting` - the problem, its transcription, the IPOPT NLP, results with
+  uncertainties and identifiability, profile intervals, plots;
+* :mod:`estimate.diagnosis` - evidence of what a fit gets wrong, candidate extensions,
+  the held-out search and its report;
+* :mod:`estimate.analysis` - what a fitted or declared analog predicts (Monte Carlo force
+  dispersion, spacecraft nutation time constant);
+* :mod:`estimate.cli` - the ``slosh`` command line, one module per command.
 
 Public API::
 
@@ -9,24 +17,31 @@ Public API::
     print(result.report())
 """
 
-from .case import Case, CaseError, load_case, write_case
-from .diagnose import Diagnosis, Finding, diagnose
-from .experiment import Experiment, experiment
-from .fit import Hessian, fit
-from .models import BASELINE, model_from_spec
-from .ntc import (NutationTimeConstant, envelope_growth_rate, linearize, nutation_time_constant,
-                  steady_spin)
-from .problem import FitProblem
-from .profile import profile_interval
-from .result import FitResult
-from .transcription import Collocation, MultipleShooting
+from .analysis.ntc import (
+                           NutationTimeConstant,
+                           envelope_growth_rate,
+                           linearize,
+                           nutation_time_constant,
+                           steady_spin,
+)
+from .data.case import Case, CaseError
+from .data.experiment import Experiment, experiment
+from .data.models import BASELINE, model_from_spec
+from .data.reader import load_case
+from .data.writer import write_case
+from .diagnosis.search import Diagnosis, Finding, diagnose
+from .fitting.nlp import Hessian, fit
+from .fitting.problem import FitProblem
+from .fitting.profile import profile_interval
+from .fitting.result import FitResult
+from .fitting.transcription import Collocation, MultipleShooting
 
 __all__ = [
     "BASELINE",
     "Case",
     "CaseError",
-    "Diagnosis",
     "Collocation",
+    "Diagnosis",
     "Experiment",
     "FitProblem",
     "FitResult",

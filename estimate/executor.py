@@ -11,6 +11,8 @@ import os
 from collections.abc import Callable, Iterable, Sequence
 from typing import Any
 
+from analogs.errors import InputError, MissingDependency
+
 __all__ = ["DaskExecutor", "Executor", "LocalExecutor", "chunks", "executor_for"]
 
 
@@ -68,8 +70,9 @@ def _import_distributed():
     try:
         import distributed
     except ImportError as err:  # pragma: no cover - depends on the environment
-        raise ImportError("the Dask executor needs dask.distributed: "
-                          "`pip install 'slosh-analogs[dask]'`") from err
+        raise MissingDependency("the Dask executor needs dask.distributed: "
+                                "`python3 -m pip install '.[dask]'` (from a checkout) or "
+                                "`python3 -m pip install 'slosh-analogs[dask]'`") from err
     return distributed
 
 
@@ -93,7 +96,7 @@ class DaskExecutor(Executor):
     def __init__(self, address: str | None = None, *, n_workers: int | None = None,
                  client: Any = None) -> None:
         if address is not None and client is not None:
-            raise ValueError("pass either `address` or `client`, not both")
+            raise InputError("pass either `address` or `client`, not both")
         distributed = _import_distributed()
         self._own = client is None
         self._cluster = None
@@ -133,7 +136,7 @@ def executor_for(scheduler: str | None = None, *, local: bool = False,
     ``scheduler`` (``"tcp://host:8786"``) or an embedded local cluster."""
     if local:
         if scheduler is not None:
-            raise ValueError("`--scheduler` and `--local` exclude each other")
+            raise InputError("`--scheduler` and `--local` exclude each other")
         return LocalExecutor()
     return DaskExecutor(scheduler, n_workers=n_workers)
 

@@ -27,23 +27,24 @@ os.environ.setdefault("OMP_NUM_THREADS", "1")
 os.environ.setdefault("OPENBLAS_NUM_THREADS", "1")
 os.environ.setdefault("MKL_NUM_THREADS", "1")
 
-import argparse  # noqa: E402
-import json  # noqa: E402
-import math  # noqa: E402
-import sys  # noqa: E402
-from pathlib import Path  # noqa: E402
+import argparse
+import json
+import math
+import sys
+from pathlib import Path
 
-import numpy as np  # noqa: E402
+import numpy as np
 
 HERE = Path(__file__).resolve().parent
 REPO = HERE.parent
 sys.path.insert(0, str(REPO / "tests"))
 sys.path.insert(0, str(REPO))
 
-from reference_models import Crank, Pendulum, hinge_damping, simulate_lateral  # noqa: E402
+from reference_models import Crank, Pendulum, hinge_damping, simulate_lateral
 
-from estimate.case import Crank as CaseCrank  # noqa: E402
-from estimate.case import Liquid, Prediction, Rig, Tank, TestInfo, write_case  # noqa: E402
+from estimate.data import write_case
+from estimate.data.case import Crank as CaseCrank
+from estimate.data.case import Liquid, Prediction, Rig, Tank, TestInfo
 
 GRAVITY = 9.80665
 DRY_MASS = 1.2
@@ -171,7 +172,8 @@ def main(argv: list[str] | None = None) -> int:
             "max_abs_theta_rad": float(np.max(np.abs(theta))),
             "rms_force_N": float(np.sqrt(np.mean(np.asarray(sim["force_clean"]) ** 2))),
         }
-        print(f"wrote {name}.toml, {name}.csv  (max |theta| {truth['cases'][name]['max_abs_theta_rad']:.3f} rad, "
+        theta_max = truth['cases'][name]['max_abs_theta_rad']
+        print(f"wrote {name}.toml, {name}.csv  (max |theta| {theta_max:.3f} rad, "
               f"RMS force {truth['cases'][name]['rms_force_N']:.3f} N)")
 
     (out / "A1_params.json").write_text(json.dumps(params, indent=2) + "\n")

@@ -30,7 +30,7 @@ Measurement effects (all optional):
 Excitations are objects returning ``(x, xd, xdd)`` at any times, with analytic derivatives:
 :class:`Sine`, :class:`Crank` (the seed's "locomotive arm"), :class:`LinearSweep`,
 :class:`SteppedSweep` and :class:`AmplitudeSteps` (the last two with smooth C2 transitions so the
-acceleration stays finite and continuous).
+acceleration stays finite and continuous), and :class:`Ramped`, any of them faded in from rest.
 
 Example
 -------
@@ -51,13 +51,13 @@ os.environ.setdefault("OMP_NUM_THREADS", "1")
 os.environ.setdefault("OPENBLAS_NUM_THREADS", "1")
 os.environ.setdefault("MKL_NUM_THREADS", "1")
 
-from collections.abc import Sequence  # noqa: E402
-from dataclasses import dataclass  # noqa: E402
-from typing import Protocol  # noqa: E402
+from collections.abc import Sequence
+from dataclasses import dataclass
+from typing import Protocol
 
-import numpy as np  # noqa: E402
-from numpy.typing import ArrayLike, NDArray  # noqa: E402
-from scipy.integrate import solve_ivp  # noqa: E402
+import numpy as np
+from numpy.typing import ArrayLike, NDArray
+from scipy.integrate import solve_ivp
 
 __all__ = [
     "AmplitudeSteps",
@@ -66,6 +66,7 @@ __all__ = [
     "Friction",
     "LinearSweep",
     "Pendulum",
+    "Ramped",
     "Sine",
     "SteppedSweep",
     "Tone",
@@ -332,6 +333,37 @@ class AmplitudeSteps:
         a, da, dda, _ = _smoothstep_levels(tt, self.amplitudes, self.dwell, self.ramp)
         w = 2.0 * np.pi * self.frequency
         return _harmonic(a, da, dda, w * tt + self.phase, w * np.ones_like(tt), np.zeros_like(tt))
+
+
+@dataclass(frozen=True)
+class Ramped:
+    """A drive faded in from rest, as rig tests start: ``x = s(t) x0(t)`` with ``s`` a quintic
+    smoothstep from 0 at ``start`` [s] to 1 at ``start + duration`` [s] (C2: the carriage
+    never jerks), 0 before; derivatives by the product rule.
+
+    Attributes
+    ----------
+    drive : Excitation
+        The steady drive ``x0(t)``.
+    duration : float
+        Ramp length [s].
+    start : float, default 0
+        Time the ramp begins [s]; the carriage is at rest before.
+    """
+
+    drive: Excitation
+    duration: float
+    start: float = 0.0
+
+    def __call__(self, t: ArrayLike) -> tuple[Array, Array, Array]:
+        tt = np.asarray(t, dtype=float)
+        x0, xd0, xdd0 = self.drive(tt)
+        u = np.clip((tt - self.start) / self.duration, 0.0, 1.0)
+        inside = (u > 0.0) & (u < 1.0)
+        s = 10 * u**3 - 15 * u**4 + 6 * u**5
+        ds = np.where(inside, (30 * u**2 - 60 * u**3 + 30 * u**4) / self.duration, 0.0)
+        dds = np.where(inside, (60 * u - 180 * u**2 + 120 * u**3) / self.duration**2, 0.0)
+        return s * x0, ds * x0 + s * xd0, dds * x0 + 2 * ds * xd0 + s * xdd0
 
 
 # ----------------------------------------------------------------------------------------------

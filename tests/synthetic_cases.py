@@ -9,10 +9,11 @@ from __future__ import annotations
 from pathlib import Path
 
 import numpy as np
-
 import reference_models as ref
-from estimate.case import Crank as CrankTable
-from estimate.case import Liquid, Prediction, Rig, Tank, TestInfo, write_case
+
+from estimate.data import write_case
+from estimate.data.case import Crank as CrankTable
+from estimate.data.case import Liquid, Prediction, Rig, Tank, TestInfo
 
 #: The seed's 8-inch sphere at 60 % fill (Table 8).
 PREDICTION_60 = Prediction(pendulum_mass=1.338, pendulum_length=0.057, fixed_mass=1.456,
@@ -66,7 +67,8 @@ def make_spinning_case(folder: Path, name: str, rig, *, pendulum=None, rotor=Non
     ``name.toml``/``.csv`` for ``rig = "spinning"``. ``rig`` is a ``reference_spinning.Rig``.
     Returns ``(case, simulation dict)``."""
     import reference_spinning as rs
-    from estimate.case import Spin
+
+    from estimate.data.case import Spin
 
     t = np.arange(int(round(duration * rate)) + 1) / rate
     sim = rs.simulate_spinning(t, rig, pendulum=pendulum, rotor=rotor, fixed_mass=fixed_mass,

@@ -10,7 +10,8 @@ EXPECT = {
     "01_fit_lateral_test.ipynb": ["identifiable combination is p1.frequency_hz"],
     "02_diagnose.ipynb": ["slosh_mode: "],
     "03_export_and_montecarlo.ipynb": ["Monte Carlo: 200 draws"],
-    "04_spinning_rig_and_ntc.ipynb": ["Nutation decays", "Nutation grows"] + ["NTC, linearised about steady spin"] * 4,
+    "04_spinning_rig_and_ntc.ipynb": (["Nutation decays", "Nutation grows"]
+                                      + ["NTC, linearised about steady spin"] * 4),
 }
 
 

@@ -11,7 +11,7 @@ from scipy.signal import find_peaks
 
 sys.path.insert(0, str(Path(__file__).parent))
 
-from reference_models import (  # noqa: E402
+from reference_models import (
     AmplitudeSteps,
     Crank,
     Friction,

@@ -2,14 +2,13 @@
 derived model of the same rig and analogs (SymPy -> CasADi), all six channels."""
 
 import numpy as np
+from reference_spinning import CHANNELS, Rig, simulate_spinning
+from reference_spinning import Rotor as RefRotor
+from reference_spinning import SphericalPendulum as RefPendulum
 
 from analogs import FixedMass, HingeDamper, HingeSpring, Rotor, SphericalPendulum
 from analogs.spinning import SpinningRig
 from derive import Adaptive, simulate
-from reference_spinning import CHANNELS, Rig
-from reference_spinning import Rotor as RefRotor
-from reference_spinning import SphericalPendulum as RefPendulum
-from reference_spinning import simulate_spinning
 
 #: Both sides integrate to rtol ~1e-11 (DOP853 and CVODES); 1e-6 relative RMS per channel
 #: (issue 7, like the lateral reference of issue 2) leaves a margin of ~1e3.

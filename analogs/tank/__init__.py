@@ -15,8 +15,16 @@ Examples
 
 from .damping import cylinder_damping, sphere_damping
 from .geometry import WATER, Capsule, Cylinder, Liquid, Profile, Sphere, Tank
-from .prediction import (Exact, FiniteElements, FixedMassPrediction, Legacy, Ritz, SloshMode,
-                         TankPrediction, predict)
+from .prediction import (
+                         Exact,
+                         FiniteElements,
+                         FixedMassPrediction,
+                         Legacy,
+                         Ritz,
+                         SloshMode,
+                         TankPrediction,
+                         predict,
+)
 
 __all__ = [
     "WATER",

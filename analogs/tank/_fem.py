@@ -128,7 +128,10 @@ def solve(tank: Tank, depth: float, *, degree: int = 8, layers: int = 8, ratio: 
     sx_s = (2.0 / hs)[None, :, None, None]
 
     ein = "abxy,xi,yj,xk,yl->abijkl"
-    kt = lambda c, X, Y, X2, Y2: np.einsum(ein, c, X, Y, X2, Y2, optimize=True)  # noqa: E731
+
+    def kt(c, X, Y, X2, Y2):
+        return np.einsum(ein, c, X, Y, X2, Y2, optimize=True)
+
     K = (kt(c_tt * sx_t**2, ld, lv, ld, lv)
          + kt(c_ts * sx_t * sx_s, ld, lv, lv, ld)
          + kt(c_ts * sx_t * sx_s, lv, ld, ld, lv)

@@ -2,8 +2,17 @@
 
 import pytest
 
-from analogs import (Component, FixedMass, HingeDamper, HingeSpring, LateralRig, ModelError, Param,
-                     Pendulum, QuadraticDamper)
+from analogs import (
+    Component,
+    FixedMass,
+    HingeDamper,
+    HingeSpring,
+    LateralRig,
+    ModelError,
+    Param,
+    Pendulum,
+    QuadraticDamper,
+)
 from derive import ParameterError, derive, simulate
 
 
@@ -60,6 +69,7 @@ def test_a_user_declares_a_new_analog_in_a_few_lines():
         """A mass on a lateral spring, at a height in the tank frame."""
 
         coordinates = ("s",)
+        coordinate_units = {"s": "m"}
         parameters = {"mass": Param("kg", lower=0.0), "stiffness": Param("N/m", lower=0.0),
                       "height": Param("m", 0.0)}
 
@@ -76,7 +86,8 @@ def test_a_user_declares_a_new_analog_in_a_few_lines():
 
 
 def test_quadratic_damper_lowers_amplitude_more_at_large_swings():
-    base = LateralRig() + Pendulum("p1", mass=1.0, length=0.05) + QuadraticDamper("p1", quadratic_damping=0.01)
+    base = (LateralRig() + Pendulum("p1", mass=1.0, length=0.05)
+            + QuadraticDamper("p1", quadratic_damping=0.01))
     import numpy as np
     t = np.linspace(0, 2, 401)
     small = simulate(base, {"rig.dry_mass": 0.0}, t, x0={"p1.theta": 0.02}).state("p1.theta")

@@ -75,7 +75,7 @@ def test_mount_rejects_what_it_cannot_wrap():
 
 @pytest.mark.slow
 def test_two_opposite_tanks_on_a_spacecraft_ntc_and_major_axis_rule():
-    from estimate.ntc import nutation_time_constant
+    from estimate.analysis.ntc import nutation_time_constant
 
     def tank(name, azimuth):
         return (Mounted(SphericalPendulum(name, mass=20.0, length=0.25, hinge_height=0.1),

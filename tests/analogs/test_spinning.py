@@ -7,12 +7,12 @@ import math
 import numpy as np
 import pytest
 import sympy as sp
+from tolerances import SYMBOLIC
 
 from analogs import FixedMass, Pendulum, Rotor, SphericalPendulum
 from analogs.spinning import SpinningRig
 from derive import Adaptive, simulate
 from derive._lagrange import assemble
-from tolerances import SYMBOLIC
 
 #: CVODES at rtol 1e-11: states are accurate to ~1e-9 over a few seconds; 1e-7 leaves a
 #: margin of 100 and is still far below any modelling error the checks look for (a wrong

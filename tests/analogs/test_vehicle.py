@@ -12,8 +12,7 @@ import numpy as np
 import pytest
 import sympy as sp
 
-from analogs import (FixedMass, HingeDamper, HingeSpring, LateralRig, Pendulum, Rig, Rotor,
-                     SphericalPendulum)
+from analogs import FixedMass, HingeDamper, HingeSpring, LateralRig, Pendulum, Rig, Rotor, SphericalPendulum
 from analogs.vehicle import VehicleFrame
 from derive import RK4, Excitation, Sine, derive, simulate
 

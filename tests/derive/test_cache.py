@@ -7,6 +7,7 @@ import sys
 from pathlib import Path
 
 import numpy as np
+import pytest
 
 from analogs import FixedMass, HingeDamper, HingeSpring, LateralRig, Pendulum
 from derive import derive
@@ -52,3 +53,105 @@ def test_changing_the_structure_changes_the_cache_key_but_values_do_not():
     c = LateralRig() + FixedMass("fixed") + Pendulum("p1", plane="yz")
     assert a.structure_key() == b.structure_key()
     assert a.structure_key() != c.structure_key()
+
+
+_SLIDING = '''
+from analogs import Component, Param
+
+class SlidingMass(Component):
+    coordinates = ("s",)
+    coordinate_units = {{"s": "m"}}
+    parameters = {{"mass": Param("kg", lower=0.0), "stiffness": Param("N/m", lower=0.0)}}
+
+    def declare(self, k):
+        s, p = k.q.s, k.p
+        k.add_particle(p.mass, s * k.tank.x)
+        k.add_potential({factor} * p.stiffness * s**2 / 2)
+'''
+
+
+def _sliding_rhs(factor: float) -> float:
+    """Acceleration of an exec-defined sliding mass at s = 0.1 m with k = 10 N/m, m = 1 kg,
+    the carriage at rest: -factor k s / m."""
+    ns: dict = {}
+    exec(_SLIDING.format(factor=factor), ns)  # no source file: inspect cannot read it
+    model = LateralRig() + ns["SlidingMass"]("s1")
+    with pytest.warns(RuntimeWarning, match="without the on-disk cache"):
+        dm = derive(model)
+    assert not dm.from_cache
+    values = dict(zip(dm.parameter_names, [0.0] * len(dm.parameter_names)))
+    values |= {"rig.dry_mass": 1.0, "rig.gravity": 9.81, "s1.mass": 1.0, "s1.stiffness": 10.0}
+    p = [values[n] for n in dm.parameter_names]
+    return float(np.asarray(dm.rhs([0.1, 0.0], [0.0, 0.0, 0.0], p, 0.0))[1, 0])
+
+
+def test_an_exec_defined_component_is_rederived_after_a_change():
+    """The bug: the second derive hit the cache (keyed by the class name) and returned the
+    first spring. A class without readable source is never cached."""
+    assert _sliding_rhs(1.0) == pytest.approx(-1.0, rel=1e-12)
+    assert _sliding_rhs(5.0) == pytest.approx(-5.0, rel=1e-12)
+
+
+def test_base_class_and_module_helper_are_in_the_key(tmp_path, monkeypatch):
+    """Editing a base class or a module-level helper that ``declare`` calls changes the key
+    (importlib.reload gives new class objects from the edited files)."""
+    import importlib
+
+    (tmp_path / "base_mod.py").write_text(
+        "from analogs import Component, Param\n"
+        "class Base(Component):\n"
+        "    parameters = {'mass': Param('kg', lower=0.0)}\n")
+    (tmp_path / "sub_mod.py").write_text(
+        "from base_mod import Base\n"
+        "def height(p):\n    return 0.1\n"
+        "class Sub(Base):\n"
+        "    coordinates = ('s',)\n"
+        "    coordinate_units = {'s': 'm'}\n"
+        "    def declare(self, k):\n"
+        "        k.add_particle(k.p.mass, k.q.s * k.tank.x + height(k.p) * k.tank.z)\n")
+    monkeypatch.syspath_prepend(str(tmp_path))
+    import base_mod
+    import sub_mod
+
+    def key():
+        return (LateralRig() + sub_mod.Sub("s1")).structure_key()
+
+    k0 = key()
+    (tmp_path / "base_mod.py").write_text((tmp_path / "base_mod.py").read_text()
+                                         + "    hinge_angles = ('s',)\n")
+    importlib.reload(base_mod)
+    importlib.reload(sub_mod)
+    k1 = key()
+    (tmp_path / "sub_mod.py").write_text(
+        (tmp_path / "sub_mod.py").read_text().replace("return 0.1", "return 0.2"))
+    importlib.reload(sub_mod)
+    k2 = key()
+    assert len({k0, k1, k2}) == 3
+
+
+def test_damaged_cache_entries_are_rebuilt(tmp_path, monkeypatch):
+    monkeypatch.setenv("SLOSH_CACHE_DIR", str(tmp_path))
+    model = _two_pendulum()
+    derive(model)
+    (entry,) = tmp_path.glob("*.json")
+    good = entry.read_bytes()
+    args = ([0.1, -0.2, 0.3, 0.4], [0.0, 0.1, -2.0],
+            list(range(1, len(derive(model).parameter_names) + 1)), 0.5)
+    expected = np.asarray(derive(model, use_cache=False).rhs(*args))
+    for damage in (b"", good[: len(good) // 2], good.replace(b"p1.theta", b"p1.thetb")):
+        entry.write_bytes(damage)
+        with pytest.warns(RuntimeWarning, match="damaged"):
+            dm = derive(model)
+        assert not dm.from_cache
+        assert np.array_equal(np.asarray(dm.rhs(*args)), expected)
+        assert derive(model).from_cache  # rewritten whole
+    assert tmp_path.stat().st_mode & 0o077 == 0  # created private to the user
+
+
+def test_a_cache_folder_writable_by_others_is_refused(tmp_path, monkeypatch):
+    folder = tmp_path / "shared"
+    folder.mkdir(mode=0o777)
+    folder.chmod(0o777)
+    monkeypatch.setenv("SLOSH_CACHE_DIR", str(folder))
+    with pytest.raises(PermissionError, match="writable by other users"):
+        derive(_two_pendulum())

@@ -126,3 +126,27 @@ def test_export_errors(tmp_path):
     export_c(two_pendulums(), tmp_path, PARAMS)
     with pytest.raises(FileExistsError, match="overwrite"):
         export_c(two_pendulums(), tmp_path, PARAMS)
+
+
+def test_state_units_come_from_the_component_not_the_coordinate_name(tmp_path):
+    """A rotational coordinate called ``angle`` is exported in rad because its component
+    says so (the exporter used to guess from names and wrote m)."""
+    from analogs import Component, Param
+
+    class Paddle(Component):
+        coordinates = ("angle",)
+        coordinate_units = {"angle": "rad"}
+        parameters = {"mass": Param("kg", lower=0.0), "arm": Param("m", lower=0.0)}
+
+        def declare(self, k):
+            import sympy as sp
+
+            k.add_particle(k.p.mass, k.p.arm * (sp.sin(k.q.angle) * k.tank.x
+                                                - sp.cos(k.q.angle) * k.tank.z))
+
+    dm = derive(LateralRig() + FixedMass("fixed") + Paddle("b1"))
+    assert dm.state_units == ("rad", "rad/s")
+    export_c(dm.model, tmp_path, {"rig.dry_mass": 1.0, "fixed.mass": 1.0, "b1.mass": 0.5,
+                                  "b1.arm": 0.1})
+    sources = " ".join(f.read_text() for f in tmp_path.glob("*.[ch]"))
+    assert 'state_units[SLOSH_MODEL_NX + 1] = {"rad", "rad/s", 0}' in sources

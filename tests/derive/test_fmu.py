@@ -13,11 +13,11 @@ from derive.export_c import has_c_compiler
 fmpy = pytest.importorskip("fmpy", reason="FMU tests need FMPy (extra `fmu`)")
 pytestmark = pytest.mark.skipif(not has_c_compiler(), reason="no C compiler (cc/gcc/$CC) found")
 
-from fmpy import extract, read_model_description  # noqa: E402
-from fmpy.fmi2 import FMU2Slave  # noqa: E402
-from fmpy.validation import validate_fmu  # noqa: E402
+from fmpy import extract, read_model_description
+from fmpy.fmi2 import FMU2Slave
+from fmpy.validation import validate_fmu
 
-from derive.fmu import export_fmu  # noqa: E402
+from derive.fmu import export_fmu
 
 #: Same RK4 arithmetic on both sides: only rounding differs (0 to 1e-14 observed).
 SAME_ARITHMETIC = 1e-9

@@ -56,8 +56,8 @@ def test_crank_rig_drives_a_rigid_tank_with_hand_derived_acceleration():
     sym = assemble(LateralRig(excitation="crank") + FixedMass("fixed"))
     P = dict(zip(sym.parameters, sym.p))
     t = sym.t
-    r, l, f, dw, phi0 = (P[f"rig.{n}"] for n in
-                         ("crank_radius", "rod_length", "drive_frequency", "omega_correction", "flywheel_angle"))
+    names = ("crank_radius", "rod_length", "drive_frequency", "omega_correction", "flywheel_angle")
+    r, l, f, dw, phi0 = (P[f"rig.{n}"] for n in names)
     phi = phi0 + (2 * sp.pi * f + dw) * t
     x = r * sp.cos(phi) + sp.sqrt(l**2 - r**2 * sp.sin(phi) ** 2) - l
     expected = (P["rig.dry_mass"] + P["fixed.mass"]) * sp.diff(x, t, 2)

@@ -4,11 +4,19 @@ import math
 
 import numpy as np
 import pytest
+import tolerances as tol
 from scipy.integrate import solve_ivp
 
-import tolerances as tol
-from analogs import (FixedMass, HingeDamper, HingeSpring, LateralRig, Pendulum, Rotor,
-                     SphericalPendulum, SuspendedMass)
+from analogs import (
+    FixedMass,
+    HingeDamper,
+    HingeSpring,
+    LateralRig,
+    Pendulum,
+    Rotor,
+    SphericalPendulum,
+    SuspendedMass,
+)
 from derive import RK4, Adaptive, NoExcitation, Sampled, Sine, derive, simulate
 
 G = 9.80665
@@ -153,7 +161,8 @@ def test_rotor_keeps_its_angular_momentum_and_damping_decays_it_exponentially():
 
 def test_suspended_mass_oscillates_at_sqrt_k_over_m_and_conserves_energy():
     m, k = 0.3, 120.0
-    model = LateralRig() + SuspendedMass("s1", axes="xy", mass=m, height=0.05, stiffness_x=k, stiffness_y=2 * k)
+    model = LateralRig() + SuspendedMass("s1", axes="xy", mass=m, height=0.05, stiffness_x=k,
+                                         stiffness_y=2 * k)
     t = np.linspace(0.0, 4.0, 4001)
     sim = simulate(model, {"rig.dry_mass": 0.0}, t, integrator=TIGHT,
                    x0={"s1.s_x": 0.01, "s1.s_y": 0.02}, outputs=("kinetic_energy", "potential_energy"))

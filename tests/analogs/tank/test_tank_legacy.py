@@ -10,10 +10,9 @@ others (docs/tank-modes.md).
 """
 
 import pytest
+from tank_tolerances import TABLE_DAMPING_REL, TABLE_UNIT
 
 from analogs.tank import Cylinder, Legacy, Liquid, Sphere, predict
-
-from tank_tolerances import TABLE_DAMPING_REL, TABLE_UNIT
 
 R = 0.1016
 WATER = Liquid(998.2, 0.893e-6, "water")

@@ -1,0 +1,427 @@
+"""Monte Carlo of a fitted analog over its parameters' uncertainty.
+
+Parameters are drawn from the fit's covariance (a multivariate normal truncated to the
+parameter bounds by rejection: draws outside the bounds are redrawn, never clipped), all in
+this process from one seed; the draws are simulated in fixed-size batches (one CasADi
+function mapped over the batch, compiled to C when a compiler exists) on an executor
+(:mod:`estimate.executor`). Batches are deterministic, so results are identical whichever
+executor runs them.
+"""
+
+from __future__ import annotations
+
+import hashlib
+import math
+import time as _time
+from collections.abc import Mapping, Sequence
+from dataclasses import dataclass, field
+from pathlib import Path
+
+import casadi as ca
+import numpy as np
+
+from analogs.errors import InputError
+from derive import DerivedModel, Excitation, NoExcitation, rk4_step
+
+from ..executor import Executor, LocalExecutor, chunks
+
+__all__ = ["Fit", "read_fit", "draw_parameters", "MonteCarlo", "MonteCarloResult",
+           "monte_carlo", "derived_quantities", "PERCENTILES"]
+
+#: Percentiles of the envelopes and derived-quantity summaries.
+PERCENTILES = (2.5, 5.0, 50.0, 95.0, 97.5)
+
+
+@dataclass(frozen=True)
+class Fit:
+    """What Monte Carlo and export need from the JSON that ``slosh fit`` writes."""
+
+    path: Path | None
+    model_spec: str
+    case: str | None
+    values: Mapping[str, float]
+    units: Mapping[str, str]
+    lower: Mapping[str, float]
+    upper: Mapping[str, float]
+    estimated: tuple[str, ...]
+    covariance_names: tuple[str, ...]
+    covariance: np.ndarray = field(repr=False)
+
+
+def _number(v, default: float) -> float:
+    if v is None:
+        return default
+    return float(v)
+
+
+def read_fit(path: str | Path) -> Fit:
+    """Read a fit result (the JSON of ``slosh fit``).
+
+    Raises
+    ------
+    ValueError
+        Naming the file and every problem: missing keys, a covariance that is not square,
+        names that are not parameters.
+    """
+    from ..fitting.params_io import read_json
+
+    path = Path(path)
+    data = read_json(path, "fit file")
+    problems = []
+    params = data.get("parameters") if isinstance(data, dict) else None
+    if not isinstance(params, dict) or not params:
+        raise InputError(f"{path}: expected a fit result with a \"parameters\" object")
+    spec = data.get("model_spec") or ",".join(data.get("model") or [])
+    if not spec:
+        problems.append("missing \"model_spec\" (e.g. \"fixed,p1\")")
+    values, units, lower, upper, estimated = {}, {}, {}, {}, []
+    for name, entry in params.items():
+        if not isinstance(entry, dict) or not isinstance(entry.get("value"), (int, float)):
+            problems.append(f"parameters.{name}: expected {{\"value\": number, ...}}")
+            continue
+        values[name] = float(entry["value"])
+        units[name] = str(entry.get("unit", ""))
+        lower[name] = _number(entry.get("lower"), -math.inf)
+        upper[name] = _number(entry.get("upper"), math.inf)
+        if entry.get("estimated", False):
+            estimated.append(name)
+    cov = data.get("covariance") or {}
+    names = tuple(cov.get("parameters") or ())
+    matrix = np.asarray(cov.get("matrix") if cov.get("matrix") is not None else np.zeros((0, 0)),
+                        float)
+    if names and matrix.shape != (len(names), len(names)):
+        problems.append(f"covariance.matrix must be {len(names)}x{len(names)} "
+                        f"(one row per covariance.parameters), found shape {matrix.shape}")
+    unknown = [n for n in names if n not in values]
+    if unknown:
+        problems.append(f"covariance.parameters not in parameters: {', '.join(unknown)}")
+    if problems:
+        raise InputError(f"{path}: " + "; ".join(problems))
+    return Fit(path=path, model_spec=spec, case=data.get("case"), values=values, units=units,
+               lower=lower, upper=upper, estimated=tuple(estimated), covariance_names=names,
+               covariance=matrix)
+
+
+def draw_parameters(fit: Fit, samples: int, *, seed: int | None = 0,
+                    max_rounds: int = 200) -> tuple[np.ndarray, float]:
+    """``samples`` draws of the covariance parameters, truncated to their bounds.
+
+    Returns
+    -------
+    draws : array, shape (samples, len(fit.covariance_names))
+    acceptance : float
+        Fraction of normal draws inside the bounds.
+
+    Raises
+    ------
+    ValueError
+        When the covariance is not symmetric positive semi-definite, or fewer than one in
+        ``max_rounds`` draws lands inside the bounds.
+    """
+    if samples < 1:
+        raise InputError(f"samples must be at least 1, got {samples}")
+    names = fit.covariance_names
+    if not names:
+        raise InputError(f"{fit.path}: the fit has no covariance; Monte Carlo needs "
+                         "`covariance.parameters` and `covariance.matrix`")
+    C = fit.covariance
+    if not np.allclose(C, C.T, rtol=1e-10, atol=0.0) or not np.all(np.isfinite(C)):
+        raise InputError(f"{fit.path}: covariance.matrix must be symmetric and finite")
+    w, V = np.linalg.eigh((C + C.T) / 2)
+    if w.min() < -1e-10 * max(w.max(), 0.0):
+        raise InputError(f"{fit.path}: covariance.matrix is not positive semi-definite "
+                         f"(smallest eigenvalue {w.min():.3g})")
+    L = V * np.sqrt(np.clip(w, 0.0, None))
+    mu = np.array([fit.values[n] for n in names])
+    lo = np.array([fit.lower[n] for n in names])
+    hi = np.array([fit.upper[n] for n in names])
+    rng = np.random.default_rng(seed)
+    out, drawn = [], 0
+    need = samples
+    for _ in range(max_rounds):
+        z = rng.standard_normal((max(need, 64), len(names)))
+        x = mu + z @ L.T
+        drawn += x.shape[0]
+        ok = np.all((x >= lo) & (x <= hi), axis=1)
+        out.append(x[ok][:need])
+        need -= out[-1].shape[0]
+        if need == 0:
+            break
+    else:
+        raise InputError(f"only {samples - need} of {samples} draws fell inside the parameter "
+                         f"bounds after {drawn} tries; check the covariance and the bounds")
+    accepted = sum(o.shape[0] for o in out)
+    return np.vstack(out), accepted / drawn
+
+
+def derived_quantities(dm: DerivedModel, P: np.ndarray) -> dict[str, np.ndarray]:
+    """Per draw, every quantity the model's components derive (columns of ``P`` in
+    ``dm.parameter_names`` order; :meth:`analogs.Model.derived_quantities`), e.g. the
+    small-amplitude frequency and damping ratio of each pendulum including hinge and
+    diaphragm terms."""
+    values = {n: P[:, i] for i, n in enumerate(dm.parameter_names)}
+    found = dm.model.derived_quantities(values)
+    return {k: np.broadcast_to(np.asarray(v, float), (P.shape[0],)).copy()
+            for k, (v, _) in found.items()}
+
+
+def _stage_inputs(exc: Excitation, t: np.ndarray, nu: int) -> tuple[np.ndarray, np.ndarray]:
+    """Inputs at the RK4 stage times ``(3 nu, n)`` (stage by stage in each column) and on
+    the grid ``(nu, n + 1)``, as :func:`derive.simulate` samples them."""
+    from derive.simulate import interval_inputs
+
+    U = interval_inputs(exc, t, np.array([0.0, 0.5, 1.0]), nu)
+    return U, np.asarray(exc.values(t), float).reshape(nu, t.size)
+
+
+def _batch_function(dm: DerivedModel, t: np.ndarray, exc: Excitation, x0: np.ndarray,
+                    outputs: tuple[int, ...], batch: int) -> ca.Function:
+    """``batch(P) -> Y``: ``P`` (np x batch) parameter columns; ``Y`` ((n+1)*len(outputs) x
+    batch) the selected outputs on the grid, output by output, one column per draw (RK4 on
+    the grid, inputs at the stage times as constants)."""
+    n = t.size - 1
+    U, Ug = _stage_inputs(exc, t, dm.nu)
+    step = rk4_step(dm, 1)
+    x = ca.SX.sym("x", dm.nx)
+    u = ca.SX.sym("u", 3 * dm.nu)
+    p = ca.SX.sym("p", len(dm.parameter_names))
+    tt = ca.SX.sym("t")
+    h = ca.SX.sym("h")
+    one = ca.Function("one", [x, u, p, tt, h], [step(x, ca.reshape(u, step.size_in(1)), p, tt, h)])
+    ug = ca.SX.sym("ug", dm.nu)
+    y = dm.outputs(x, ug, p, tt)
+    out = ca.Function("out", [x, ug, p, tt], [ca.vertcat(*[y[i] for i in outputs])])
+    P = ca.MX.sym("p", p.numel())
+    X0 = ca.DM(x0)
+    X = ca.horzcat(X0, one.mapaccum("horizon", n)(X0, ca.DM(U), P, ca.DM(t[:-1]).T,
+                                                   ca.DM(np.diff(t)).T))
+    Y = out.map(n + 1)(X, ca.DM(Ug), P, ca.DM(t).T)
+    single = ca.Function("mc_single", [P], [ca.vec(Y.T)])
+    return single.map("mc_batch", "serial", batch, [], [])
+
+
+_WORKER_CACHE: dict[str, ca.Function] = {}
+
+
+@dataclass(frozen=True)
+class _Task:
+    """One batch: its parameter columns; the serialized batch function is shared."""
+
+    key: str
+    P: np.ndarray
+    compile: bool
+
+
+def _run_task(task: _Task, shared: str) -> np.ndarray:
+    fn = _WORKER_CACHE.get(task.key)
+    if fn is None:
+        fn = ca.Function.deserialize(shared)
+        if task.compile:
+            from derive._compile import compiled
+
+            fn = compiled(fn)
+        _WORKER_CACHE[task.key] = fn
+    return np.asarray(fn(task.P)).T
+
+
+@dataclass(frozen=True)
+class MonteCarloResult:
+    """Envelopes and summaries of a Monte Carlo run.
+
+    ``outputs[name]`` is ``(samples, len(time))``; ``envelopes[name][q]`` the ``q``-th
+    percentile over draws at each time; ``derived[name]`` per draw (``peak_<output>`` is
+    the largest magnitude over the run, ``pN.frequency_hz`` and ``pN.damping_ratio`` from
+    the drawn parameters).
+    """
+
+    time: np.ndarray
+    parameter_names: tuple[str, ...]
+    draws: np.ndarray
+    outputs: Mapping[str, np.ndarray]
+    derived: Mapping[str, np.ndarray]
+    seed: int | None
+    acceptance: float
+    seconds: float
+    executor: str
+    percentiles: tuple[float, ...] = PERCENTILES
+
+    @property
+    def samples(self) -> int:
+        return self.draws.shape[0]
+
+    @property
+    def draws_per_second(self) -> float:
+        return self.samples / self.seconds if self.seconds > 0 else math.inf
+
+    @property
+    def envelopes(self) -> dict[str, dict[float, np.ndarray]]:
+        return {name: dict(zip(self.percentiles, np.percentile(Y, self.percentiles, axis=0)))
+                for name, Y in self.outputs.items()}
+
+    def summary(self) -> dict[str, dict[str, float]]:
+        """Mean, standard deviation and percentiles of every derived quantity."""
+        out = {}
+        for name, v in self.derived.items():
+            q = np.percentile(v, self.percentiles)
+            out[name] = {"mean": float(np.mean(v)), "std": float(np.std(v, ddof=1)) if v.size > 1 else 0.0,
+                         **{f"p{p:g}": float(x) for p, x in zip(self.percentiles, q)}}
+        return out
+
+    def to_json(self) -> dict:
+        """The envelopes and summaries as JSON-ready data (draws not included)."""
+        return {
+            "samples": self.samples, "seed": self.seed, "acceptance": self.acceptance,
+            "seconds": self.seconds, "draws_per_second": self.draws_per_second,
+            "executor": self.executor, "percentiles": list(self.percentiles),
+            "parameters": list(self.parameter_names),
+            "parameter_summary": {
+                n: {"mean": float(np.mean(self.draws[:, i])), "std": float(np.std(self.draws[:, i], ddof=1))
+                    if self.samples > 1 else 0.0} for i, n in enumerate(self.parameter_names)},
+            "time": self.time.tolist(),
+            "envelopes": {name: {f"p{q:g}": env[q].tolist() for q in self.percentiles}
+                          for name, env in self.envelopes.items()},
+            "derived": self.summary(),
+        }
+
+    def report(self) -> str:
+        """A short text report."""
+        lines = [f"Monte Carlo: {self.samples} draws (seed {self.seed}), {self.seconds:.2f} s, "
+                 f"{self.draws_per_second:.0f} draws/s on {self.executor}; "
+                 f"{100 * self.acceptance:.1f}% of normal draws inside the bounds"]
+        head = "  ".join(f"{'p' + format(p, 'g'):>11}" for p in self.percentiles)
+        lines.append(f"{'quantity':<22}{'mean':>11}  {'std':>11}  {head}")
+        for name, s in self.summary().items():
+            vals = "  ".join(f"{s['p' + format(p, 'g')]:>11.5g}" for p in self.percentiles)
+            lines.append(f"{name:<22}{s['mean']:>11.5g}  {s['std']:>11.4g}  {vals}")
+        return "\n".join(lines)
+
+    def plot(self, path: str | Path | None = None, *, output: str | None = None):
+        """Median and percentile bands of ``output`` (default: the first) over time."""
+        import matplotlib
+
+        if path is not None:
+            matplotlib.use("Agg", force=False)
+        import matplotlib.pyplot as plt
+
+        name = output or next(iter(self.outputs))
+        env = self.envelopes[name]
+        fig, ax = plt.subplots(figsize=(9, 4))
+        qs = sorted(self.percentiles)
+        for lo, hi, alpha in ((qs[0], qs[-1], 0.25), (qs[1], qs[-2], 0.4)):
+            ax.fill_between(self.time, env[lo], env[hi], alpha=alpha, color="C0", lw=0,
+                            label=f"{lo:g}-{hi:g} %")
+        ax.plot(self.time, env[50.0], color="C0", lw=1, label="median")
+        ax.set_xlabel("time (s)")
+        ax.set_ylabel(f"{name} (N)" if name.startswith("force") else name)
+        ax.set_title(f"Monte Carlo envelope, {self.samples} draws")
+        ax.legend(loc="upper right")
+        fig.tight_layout()
+        if path is not None:
+            fig.savefig(path, dpi=120)
+            plt.close(fig)
+        return fig
+
+
+@dataclass(frozen=True)
+class MonteCarlo:
+    """A Monte Carlo problem: a derived model, its time grid and excitation, the fixed
+    parameter values, and the fit whose covariance the draws come from."""
+
+    derived: DerivedModel
+    time: np.ndarray
+    excitation: Excitation | None
+    fit: Fit
+    fixed: Mapping[str, float] = field(default_factory=dict)
+    outputs: tuple[str, ...] | None = None
+
+    def base_vector(self) -> np.ndarray:
+        """Parameter vector of the fit's values over ``fixed`` (rig values of the case)."""
+        dm = self.derived
+        known = set(dm.parameter_names)
+        values = {k: v for k, v in self.fit.values.items() if k in known}
+        return dm.parameter_vector({**values, **self.fixed}, outputs=self._outputs())
+
+    def _outputs(self) -> tuple[str, ...]:
+        return tuple(self.outputs or self.derived.measured)
+
+    def run(self, samples: int, *, seed: int | None = 0, executor: Executor | None = None,
+            batch_size: int = 256, compile: bool = True) -> MonteCarloResult:
+        """Draw ``samples`` parameter sets and simulate them in batches of ``batch_size``.
+
+        Parameters
+        ----------
+        samples : int
+            Number of draws.
+        seed : int, optional
+            Seed of NumPy's default generator for the draws (default 0).
+        executor : Executor, optional
+            Where batches run (default: :class:`~estimate.executor.LocalExecutor`).
+        batch_size : int, default 256
+            Draws per batch (one mapped CasADi function; the last batch is padded).
+        compile : bool, default True
+            Compile the batch function to C (cached on disk) when a compiler exists.
+        """
+        start = _time.perf_counter()
+        executor = executor or LocalExecutor()
+        dm = self.derived
+        names = self._outputs()
+        for n in names:
+            dm.output_index(n)
+        unknown = [n for n in self.fit.covariance_names if n not in dm.parameter_names]
+        if unknown:
+            raise InputError(f"covariance parameters {', '.join(unknown)} are not parameters of "
+                             f"the model ({', '.join(dm.parameter_names)})")
+        base = self.base_vector()
+        draws, acceptance = draw_parameters(self.fit, samples, seed=seed)
+        cols = [dm.parameter_names.index(n) for n in self.fit.covariance_names]
+        P = np.tile(np.nan_to_num(base), (samples, 1))
+        P[:, cols] = draws
+        t = np.asarray(self.time, float)
+        exc = self.excitation if self.excitation is not None else NoExcitation(size=dm.nu)
+        batch = max(1, min(batch_size, samples))
+        fn = _batch_function(dm, t, exc, np.zeros(dm.nx), tuple(dm.output_index(n) for n in names),
+                             batch)
+        text = fn.serialize()
+        key = hashlib.sha256(text.encode()).hexdigest()[:24]
+        tasks = []
+        for a, b in chunks(samples, batch):
+            Pb = P[a:b]
+            if Pb.shape[0] < batch:
+                Pb = np.vstack([Pb, np.repeat(Pb[-1:], batch - Pb.shape[0], axis=0)])
+            tasks.append(_Task(key, np.ascontiguousarray(Pb.T), compile))
+        results = executor.map(_run_task, tasks, shared=text)
+        Y = np.vstack(results)[:samples]  # (samples, len(names) * (n + 1)), output by output
+        nt = t.size
+        outputs = {name: Y[:, i * nt:(i + 1) * nt] for i, name in enumerate(names)}
+        derived = {f"peak_{name}": np.max(np.abs(v), axis=1) for name, v in outputs.items()}
+        derived |= derived_quantities(dm, P)
+        return MonteCarloResult(
+            time=t, parameter_names=self.fit.covariance_names, draws=draws, outputs=outputs,
+            derived=derived, seed=seed, acceptance=acceptance,
+            seconds=_time.perf_counter() - start,
+            executor=f"{type(executor).__name__} ({executor.workers} worker"
+                     f"{'s' if executor.workers > 1 else ''})")
+
+
+def monte_carlo(derived: DerivedModel, time: np.ndarray, excitation: Excitation | None,
+                fit: Fit, samples: int, *, fixed: Mapping[str, float] | None = None,
+                outputs: Sequence[str] | None = None, seed: int | None = 0,
+                executor: Executor | None = None, batch_size: int = 256,
+                compile: bool = True) -> MonteCarloResult:
+    """Run :class:`MonteCarlo` in one call; see :meth:`MonteCarlo.run`.
+
+    Examples
+    --------
+    >>> from estimate.data import load_case                       # doctest: +SKIP
+    >>> from estimate.data.experiment import experiment                 # doctest: +SKIP
+    >>> from estimate.data.models import model_from_spec                # doctest: +SKIP
+    >>> fit = read_fit("A1_fit.json")                               # doctest: +SKIP
+    >>> case = load_case("A1.toml")                                 # doctest: +SKIP
+    >>> exp = experiment(case, model_from_spec(fit.model_spec, case))  # doctest: +SKIP
+    >>> res = monte_carlo(exp.derived, case.time, exp.excitation, fit, 1000,
+    ...                   fixed=exp.fixed)                           # doctest: +SKIP
+    """
+    problem = MonteCarlo(derived, np.asarray(time, float), excitation, fit, dict(fixed or {}),
+                         tuple(outputs) if outputs else None)
+    return problem.run(samples, seed=seed, executor=executor, batch_size=batch_size,
+                       compile=compile)

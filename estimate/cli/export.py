@@ -1,0 +1,148 @@
+"""`slosh export`: a fitted analog as self-contained C (and/or an FMI 2.0 FMU).
+
+Wire-up: ``estimate.cli`` calls :func:`add_parser` on its subparsers and dispatches to
+:func:`run` (set as the ``func`` default).
+"""
+
+from __future__ import annotations
+
+import argparse
+import math
+import sys
+from pathlib import Path
+from types import SimpleNamespace
+
+from analogs import Model
+from analogs.errors import InputError
+from analogs.vehicle import VehicleFrame
+
+__all__ = ["add_parser", "run", "export_model"]
+
+
+def add_parser(subparsers: argparse._SubParsersAction) -> None:
+    """Add the ``export`` subcommand to an argparse subparsers object."""
+    p = subparsers.add_parser(
+        "export", help="export a fitted analog as C code (and/or an FMU)",
+        description="Generate self-contained C (CasADi code generation of rhs, outputs and a "
+                    "fixed-step RK4 step; header with state/input/parameter/output order and "
+                    "units; fitted values as defaults; Makefile; standalone driver) and/or an "
+                    "FMI 2.0 co-simulation FMU from a fit result.")
+    p.add_argument("fit", metavar="FIT.json", help="fit result (as written by `slosh fit`) "
+                   "or a flat JSON map of parameter values")
+    p.add_argument("--out", metavar="DIR", help="folder for the C sources")
+    p.add_argument("--fmu", metavar="OUT.fmu", help="write an FMI 2.0 co-simulation FMU")
+    p.add_argument("--model", default=None,
+                   help="model specification, e.g. 'fixed,p1' (default: the fit's model_spec)")
+    p.add_argument("--integrator", choices=("rk4", "adaptive"), default="rk4",
+                   help="rk4 (fixed step; the only one that can be generated as C)")
+    p.add_argument("--substeps", type=int, default=1, help="RK4 substeps per step (default 1)")
+    p.add_argument("--interface", choices=("rig", "vehicle"), default="rig",
+                   help="rig: lateral rig inputs rig.x, rig.x_dot, rig.x_ddot (default); "
+                        "vehicle: tank-frame acceleration, angular velocity and acceleration "
+                        "and gravity (analogs.vehicle.VehicleFrame)")
+    p.add_argument("--planar", action="store_true",
+                   help="with --interface vehicle: in-plane (x-z) inputs only")
+    p.add_argument("--set", metavar="NAME=VALUE", action="append", default=[],
+                   help="set a parameter the fit does not give (e.g. p1.hinge_height=0.1, "
+                        "needed by torques and by the vehicle interface); repeatable")
+    p.add_argument("--name", default="slosh_model", help="C symbol prefix / FMU model identifier")
+    p.add_argument("--step", type=float, default=0.01,
+                   help="FMU: largest internal RK4 step, s (default 0.01)")
+    p.add_argument("--no-build", action="store_true", help="do not compile the C driver")
+    p.add_argument("--overwrite", action="store_true", help="replace existing output files")
+    p.set_defaults(run=run)
+
+
+def export_model(spec: str, values: dict[str, float], *, interface: str = "rig",
+                 planar: bool = False) -> tuple[Model, dict[str, float]]:
+    """The model of ``spec`` for export and the values among ``values`` that it has.
+
+    ``interface="rig"``: a lateral rig with a measured carriage displacement (inputs
+    ``rig.x``, ``rig.x_dot``, ``rig.x_ddot``); ``"vehicle"``: the
+    :class:`~analogs.vehicle.VehicleFrame` (``planar`` for in-plane inputs only).
+    """
+    from ..data.models import model_from_spec
+
+    lateral = SimpleNamespace(test=SimpleNamespace(rig="lateral", excitation="measured"),
+                              path="(export)")
+    model = model_from_spec(spec, lateral)
+    if interface == "vehicle":
+        model = (Model((VehicleFrame(planar=planar),)) + model.without(model.rig.name)).validate()
+    elif interface != "rig":
+        raise InputError(f"interface must be 'rig' or 'vehicle', got {interface!r}")
+    names = {p.name for p in model.parameters}
+    return model, {k: v for k, v in values.items() if k in names}
+
+
+def _spec_of(path: Path) -> str | None:
+    import json
+
+    try:
+        data = json.loads(path.read_text())
+    except (OSError, ValueError):
+        return None
+    if isinstance(data, dict):
+        return data.get("model_spec") or (",".join(data["model"]) if data.get("model") else None)
+    return None
+
+
+def _assignments(items: list[str]) -> dict[str, float]:
+    out, problems = {}, []
+    for item in items:
+        name, sep, value = item.partition("=")
+        try:
+            if not sep:
+                raise ValueError
+            out[name.strip()] = float(value)
+        except ValueError:
+            problems.append(f"`--set {item}`: expected NAME=NUMBER")
+    if problems:
+        raise InputError("; ".join(problems))
+    return out
+
+
+def run(args: argparse.Namespace) -> int:
+    """Run ``slosh export``; returns the exit status."""
+    from derive import derive
+    from derive.export_c import export_c, has_c_compiler
+
+    from ..data.models import BASELINE
+    from ..fitting.params_io import read_params
+
+    if not args.out and not args.fmu:
+        raise InputError("nothing to write: give `--out DIR` for C sources and/or `--fmu OUT.fmu`")
+    if args.integrator != "rk4":
+        raise InputError("only `--integrator rk4` can be exported: CasADi's cvodes integrator "
+                         "cannot be generated as C")
+    if args.planar and args.interface != "vehicle":
+        raise InputError("`--planar` applies to `--interface vehicle` only")
+    values = read_params(args.fit) | _assignments(args.set)
+    spec = args.model or _spec_of(Path(args.fit)) or BASELINE
+    model, used = export_model(spec, values, interface=args.interface, planar=args.planar)
+    dm = derive(model)
+    pvec = dm.parameter_vector(used)
+    unset = [n for n, v in zip(dm.parameter_names, pvec) if math.isnan(v)]
+    if args.out:
+        ex = export_c(dm, args.out, used, substeps=args.substeps, name=args.name,
+                      overwrite=args.overwrite)
+        print(f"wrote C export of {spec} ({args.interface} interface) to {ex.folder}: "
+              f"{ex.header.name}, {', '.join(s.name for s in ex.sources)}, {ex.driver.name}, "
+              f"{ex.makefile.name}, {ex.parameters_csv.name}")
+        print(f"  states: {', '.join(ex.states)}")
+        print(f"  inputs: {', '.join(ex.inputs) or '(none)'}")
+        if not args.no_build and has_c_compiler():
+            try:
+                print(f"  built {ex.build()}")
+            except RuntimeError as err:
+                print(f"slosh export: error: {err}", file=sys.stderr)
+                return 2
+    if args.fmu:
+        from derive.fmu import export_fmu
+
+        fmu = export_fmu(dm, args.fmu, used, substeps=args.substeps, max_step=args.step,
+                         name=args.name, overwrite=args.overwrite)
+        print(f"wrote FMU {fmu}")
+    if unset:
+        print(f"  note: no value for {', '.join(unset)}: outputs that need them are NaN in C "
+              "and left out of the FMU")
+    return 0

@@ -1,0 +1,70 @@
+"""``slosh fit``: estimate analog parameters from one or more test cases."""
+
+from __future__ import annotations
+
+import argparse
+import json
+from pathlib import Path
+
+from ._outputs import refuse_existing
+
+__all__ = ["add_parser"]
+
+
+def add_parser(sub: argparse._SubParsersAction) -> None:
+    p = sub.add_parser(
+        "fit", help="estimate analog parameters from test cases",
+        description="Fit the analog model to the measured force of one or more cases (shared "
+                    "physical parameters, per-case crank corrections) with IPOPT.")
+    p.add_argument("cases", nargs="+", help="test case files (TOML)")
+    p.add_argument("--model", default=None,
+                   help="model specification, e.g. 'fixed,p1,p2' or 'fixed,p1:quadratic' "
+                        "(default: fixed,p1 = fixed mass + pendulum with hinge spring and damper)")
+    p.add_argument("--transcription", choices=("multiple_shooting", "collocation"),
+                   default="multiple_shooting")
+    p.add_argument("--cost", choices=("squared", "abs"), default="squared",
+                   help="sum of squared residuals (default) or the seed's sum((|E|-|S|)^2)")
+    p.add_argument("--json", dest="json_out", default=None, help="write the result as JSON")
+    p.add_argument("--plot", default=None, help="write the fit plots (PNG) of the first case")
+    p.add_argument("--report", action="store_true", help="print the full text fit report")
+    p.add_argument("--overwrite", action="store_true", help="replace existing output files")
+    p.set_defaults(run=run)
+
+
+def run(args: argparse.Namespace) -> int:
+    import sys
+
+    from ..data import load_case
+    from ..data.models import BASELINE, model_from_spec
+    from ..fitting.nlp import fit
+    from ..fitting.problem import FitProblem
+    from ..fitting.transcription import Collocation, MultipleShooting
+
+    refuse_existing([args.json_out, args.plot], args.overwrite)
+    cases = [load_case(c) for c in args.cases]
+    spec = args.model or BASELINE
+    model = model_from_spec(spec, cases[0])
+    problem = FitProblem.build(cases, model)
+    tr = MultipleShooting() if args.transcription == "multiple_shooting" else Collocation()
+    result = fit(problem, transcription=tr, cost=args.cost)
+    if args.report or sys.stdout.isatty():
+        print(result.report())
+    else:
+        print(f"{'converged' if result.converged else 'NOT converged'} ({result.status}), "
+              f"{result.iterations} iterations, {result.seconds:.2f} s, RMS residual "
+              f"{result.rms_residual:.4g} N")
+        for n, v, se, u in zip(result.names, result.values, result.stderr, result.units):
+            print(f"  {n:30s} {v:.6g} +/- {se:.2g} {u}")
+        for c in result.confounded():
+            print(f"  note: {c}")
+    for w in result.warnings:
+        print(f"warning: {w}", file=sys.stderr)
+    if args.json_out:
+        data = result.to_dict()
+        data["model_spec"] = spec
+        Path(args.json_out).write_text(json.dumps(data, indent=2))
+    if args.plot:
+        from ..fitting.plots import plot_fit
+
+        plot_fit(result, args.plot)
+    return 0 if result.converged else 1

@@ -1,0 +1,73 @@
+"""`slosh montecarlo`: simulate a fitted analog for parameter draws from its covariance.
+
+Wire-up: ``estimate.cli`` calls :func:`add_parser` on its subparsers and dispatches to
+:func:`run` (set as the ``func`` default).
+"""
+
+from __future__ import annotations
+
+import argparse
+import json
+from pathlib import Path
+
+from analogs.errors import InputError
+
+from ._outputs import refuse_existing
+
+__all__ = ["add_parser", "run"]
+
+
+def add_parser(subparsers: argparse._SubParsersAction) -> None:
+    """Add the ``montecarlo`` subcommand to an argparse subparsers object."""
+    p = subparsers.add_parser(
+        "montecarlo", help="Monte Carlo of a fitted analog over its parameter uncertainty",
+        description="Draw parameters from the fit's covariance (truncated to the bounds), "
+                    "simulate the case's excitation for every draw on a Dask cluster (embedded "
+                    "local cluster by default) and write percentile envelopes of the force and "
+                    "summaries of derived quantities (JSON + plot).")
+    p.add_argument("fit", metavar="FIT.json", help="fit result written by `slosh fit`")
+    p.add_argument("case", metavar="CASE.toml", help="test case whose excitation drives the model")
+    p.add_argument("--samples", type=int, required=True, help="number of draws")
+    p.add_argument("--seed", type=int, default=0, help="random seed (default 0)")
+    where = p.add_mutually_exclusive_group()
+    where.add_argument("--scheduler", metavar="ADDRESS", default=None,
+                       help="Dask scheduler of an existing cluster, e.g. tcp://host:8786 "
+                            "(default: an embedded local cluster)")
+    where.add_argument("--local", action="store_true", help="run in this process, no Dask")
+    p.add_argument("--workers", type=int, default=None,
+                   help="workers of the embedded local cluster (default: CPU count)")
+    p.add_argument("--batch-size", type=int, default=256, help="draws per task (default 256)")
+    p.add_argument("--model", default=None, help="model specification (default: the fit's)")
+    p.add_argument("--out", metavar="DIR", default="montecarlo",
+                   help="output folder for montecarlo.json and envelope.png (default ./montecarlo)")
+    p.add_argument("--overwrite", action="store_true", help="replace existing output files")
+    p.set_defaults(run=run)
+
+
+def run(args: argparse.Namespace) -> int:
+    """Run ``slosh montecarlo``; returns the exit status."""
+    from ..analysis.montecarlo import monte_carlo, read_fit
+    from ..data import load_case
+    from ..data.experiment import experiment
+    from ..data.models import model_from_spec
+    from ..executor import executor_for
+
+    if args.samples < 1:
+        raise InputError(f"--samples must be at least 1, got {args.samples}")
+    out = Path(args.out)
+    files = [out / "montecarlo.json", out / "envelope.png"]
+    refuse_existing(files, args.overwrite)
+    fit = read_fit(args.fit)
+    case = load_case(args.case)
+    exp = experiment(case, model_from_spec(args.model or fit.model_spec, case))
+    with executor_for(args.scheduler, local=args.local, n_workers=args.workers) as ex:
+        res = monte_carlo(exp.derived, case.time, exp.excitation, fit, args.samples,
+                          fixed=exp.fixed, seed=args.seed, executor=ex,
+                          batch_size=args.batch_size)
+    out.mkdir(parents=True, exist_ok=True)
+    data = {"fit": str(args.fit), "case": str(args.case), **res.to_json()}
+    files[0].write_text(json.dumps(data, indent=1) + "\n")
+    res.plot(files[1])
+    print(res.report())
+    print(f"wrote {files[0]} and {files[1]}")
+    return 0

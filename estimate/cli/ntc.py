@@ -1,0 +1,220 @@
+"""`slosh ntc SPACECRAFT.toml`: nutation time constant of a spinning spacecraft, two ways.
+
+Wire-up: ``estimate.cli`` calls :func:`add_parser` on its subparsers and dispatches to
+:func:`run` (set as the ``func`` default).
+
+File format (SI units; see ``examples/spacecraft.toml``)::
+
+    [spacecraft]            # the bus: FreeSpacecraft parameters
+    spin_rate = 5.0         # rad/s
+    mass = 500.0            # kg
+    inertia_x = 400.0       # kg m^2 (central, principal)
+    inertia_y = 420.0
+    inertia_z = 600.0
+    translation = true      # optional (default true)
+
+    [tank]                  # optional: tank origin relative to the bus centre of mass
+    radius = 0.8            # m from the spin axis, along bus x
+    height = 0.3            # m along the spin axis
+    axis = "inward"         # "spin" (default) or "inward"
+
+    [[analog]]              # one or more
+    type = "spherical_pendulum"   # or "pendulum", "rotor", "fixed_mass"
+    name = "p1"
+    mass = 20.0
+    length = 0.25
+    hinge_height = 0.1
+    damping = 2.0           # pendulums: hinge damping, N m s/rad (optional)
+    stiffness = 0.0         # pendulums: hinge stiffness, N m/rad (optional)
+    mount_radius = 0.8      # optional: place this analog off the tank origin (m, rad, m),
+    mount_azimuth = 3.1416  #   in its own frame (`analogs.mounted.Mounted`), e.g. a second
+    mount_height = 0.3      #   tank; mount_axis = "parallel" (default) or "inward"
+
+    [ntc]                   # optional
+    duration = 2000.0       # s
+    initial_rate = 5e-4     # rad/s
+"""
+
+from __future__ import annotations
+
+import argparse
+import json
+import sys
+import tomllib
+from pathlib import Path
+
+from analogs.errors import InputError
+
+from ._outputs import refuse_existing
+
+__all__ = ["add_parser", "run", "load_spacecraft"]
+
+_BUS_KEYS = ("spin_rate", "mass", "inertia_x", "inertia_y", "inertia_z")
+_MOUNT_KEYS = {"mount_radius", "mount_azimuth", "mount_height", "mount_axis"}
+_ANALOG_KEYS = {
+    "rotor": {"name", "type", "axis", "inertia", "damping"},
+    "pendulum": {"name", "type", "plane", "mass", "length", "hinge_height", "damping", "stiffness"},
+    "spherical_pendulum": {"name", "type", "mass", "length", "hinge_height", "damping", "stiffness"},
+    "fixed_mass": {"name", "type", "mass", "height", "inertia", "axial_inertia"},
+}
+
+
+def add_parser(subparsers: argparse._SubParsersAction) -> None:
+    """Add the ``ntc`` subcommand to an argparse subparsers object."""
+    p = subparsers.add_parser(
+        "ntc", help="nutation time constant of a spinning spacecraft with slosh analogs",
+        description="Nutation time constant (NTC = 1/sigma, positive when the nutation grows) "
+                    "from a nonlinear simulation (envelope fit) and from the eigenvalues of "
+                    "the equations linearised about steady spin.")
+    p.add_argument("spacecraft", help="spacecraft file (TOML)")
+    p.add_argument("--json", metavar="OUT.json", help="write both NTCs as JSON")
+    p.add_argument("--overwrite", action="store_true", help="replace an existing --json file")
+    p.set_defaults(run=run)
+
+
+def _number(table: dict, key: str, where: str, problems: list[str], required: bool = True):
+    if key not in table:
+        if required:
+            problems.append(f"{where}: missing `{key}`")
+        return None
+    value = table[key]
+    if isinstance(value, bool) or not isinstance(value, (int, float)):
+        problems.append(f"{where}: `{key}` must be a number, got {value!r}")
+        return None
+    return float(value)
+
+
+def load_spacecraft(path: str | Path):
+    """Read a spacecraft file: returns ``(model, params, options)``.
+
+    Raises ``ValueError`` listing every problem (file, table, key) at once.
+    """
+    from analogs import (
+        FixedMass,
+        HingeDamper,
+        HingeSpring,
+        Pendulum,
+        Rotor,
+        SphericalPendulum,
+    )
+    from analogs.mounted import Mounted
+    from analogs.spacecraft import FreeSpacecraft
+
+    path = Path(path)
+    with path.open("rb") as fh:
+        try:
+            doc = tomllib.load(fh)
+        except tomllib.TOMLDecodeError as err:
+            raise InputError(f"{path}: not valid TOML: {err}") from None
+    problems: list[str] = []
+    for key in sorted(set(doc) - {"spacecraft", "tank", "analog", "ntc"}):
+        problems.append(f"{path}: unknown table `[{key}]`; expected [spacecraft], [tank], "
+                        "[[analog]], [ntc]")
+    bus = doc.get("spacecraft")
+    if not isinstance(bus, dict):
+        problems.append(f"{path}: missing table `[spacecraft]` with {', '.join(_BUS_KEYS)}")
+        bus = {}
+    where = f"{path} [spacecraft]"
+    for key in sorted(set(bus) - set(_BUS_KEYS) - {"translation"}):
+        problems.append(f"{where}: unknown key `{key}`")
+    params = {f"bus.{k}": v for k in _BUS_KEYS
+              if (v := _number(bus, k, where, problems)) is not None}
+    translation = bus.get("translation", True)
+    if not isinstance(translation, bool):
+        problems.append(f"{where}: `translation` must be true or false, got {translation!r}")
+        translation = True
+    tank = doc.get("tank", {})
+    where = f"{path} [tank]"
+    for key in sorted(set(tank) - {"radius", "height", "axis"}):
+        problems.append(f"{where}: unknown key `{key}`")
+    for key in ("radius", "height"):
+        if (v := _number(tank, key, where, problems, required=False)) is not None:
+            params[f"bus.{key}"] = v
+    axis = tank.get("axis", "spin")
+    if axis not in ("spin", "inward"):
+        problems.append(f"{where}: `axis` must be \"spin\" or \"inward\", got {axis!r}")
+        axis = "spin"
+    components = []
+    analogs = doc.get("analog", [])
+    if not isinstance(analogs, list) or not analogs:
+        problems.append(f"{path}: no `[[analog]]` table; give at least one (rotor, pendulum, "
+                        "spherical_pendulum, fixed_mass)")
+        analogs = []
+    for i, a in enumerate(analogs, 1):
+        kind, name = a.get("type"), a.get("name", f"a{i}")
+        where = f"{path} [[analog]] #{i}"
+        if kind not in _ANALOG_KEYS:
+            problems.append(f"{where}: `type` must be one of {', '.join(_ANALOG_KEYS)}, got {kind!r}")
+            continue
+        for key in sorted(set(a) - _ANALOG_KEYS[kind] - _MOUNT_KEYS):
+            problems.append(f"{where}: unknown key `{key}` for a {kind}")
+        if not isinstance(name, str) or not name.isidentifier():
+            problems.append(f"{where}: `name` must be an identifier such as \"p1\", got {name!r}")
+            continue
+        for key in sorted(set(a) & _MOUNT_KEYS):
+            problems.extend(() if key == "mount_axis" or _number(a, key, where, [], False)
+                            is not None else [f"{where}: `{key}` must be a number"])
+        mount_axis = a.get("mount_axis", "parallel")
+        if mount_axis not in ("parallel", "inward"):
+            problems.append(f"{where}: `mount_axis` must be \"parallel\" or \"inward\", "
+                            f"got {mount_axis!r}")
+            continue
+        mount = {k: float(a[k]) for k in _MOUNT_KEYS - {"mount_axis"} if k in a
+                 and _number(a, k, where, [], False) is not None}
+        wrap = (lambda c, axis=mount_axis, mount=mount: Mounted(c, axis=axis, **mount)) \
+            if (mount or "mount_axis" in a) else (lambda c: c)
+        values = {k: _number(a, k, where, problems, required=False)
+                  for k in _ANALOG_KEYS[kind] - {"name", "type", "axis", "plane"} if k in a}
+        try:
+            if kind == "rotor":
+                components.append(wrap(Rotor(name, axis=a.get("axis", "z"), **values)))
+            elif kind == "fixed_mass":
+                components.append(wrap(FixedMass(name, **values)))
+            else:
+                hinge = {k: values.pop(k) for k in ("damping", "stiffness") if k in values}
+                if kind == "pendulum":
+                    components.append(wrap(Pendulum(name, plane=a.get("plane", "xz"), **values)))
+                else:
+                    components.append(wrap(SphericalPendulum(name, **values)))
+                components.append(HingeDamper(name, damping=hinge.get("damping", 0.0)))
+                if hinge.get("stiffness"):
+                    components.append(HingeSpring(name, stiffness=hinge["stiffness"]))
+        except (TypeError, ValueError) as err:
+            problems.append(f"{where}: {err}")
+    opts = doc.get("ntc", {})
+    where = f"{path} [ntc]"
+    for key in sorted(set(opts) - {"duration", "initial_rate"}):
+        problems.append(f"{where}: unknown key `{key}`")
+    options = {k: v for k in ("duration", "initial_rate")
+               if (v := _number(opts, k, where, problems, required=False)) is not None}
+    if problems:
+        raise InputError(f"{len(problems)} problem{'s' if len(problems) > 1 else ''} in the "
+                         "spacecraft file:\n  - " + "\n  - ".join(problems))
+    model = FreeSpacecraft(translation=translation, tank_axis=axis)
+    for c in components:
+        model = model + c
+    return model.validate(), params, options
+
+
+def run(args: argparse.Namespace) -> int:
+    """Run ``slosh ntc``; returns the exit status."""
+    from ..analysis.ntc import nutation_time_constant
+
+    refuse_existing([args.json], args.overwrite)
+    model, params, options = load_spacecraft(args.spacecraft)
+    ntc = nutation_time_constant(model, params, **options)
+    print(f"{args.spacecraft}: {model!r}")
+    print(ntc.report())
+    if args.json:
+        out = {"ntc_simulated_s": ntc.simulated, "ntc_linearized_s": ntc.linearized,
+               "growth_rate_simulated_per_s": ntc.growth_rate_simulated,
+               "growth_rate_linearized_per_s": ntc.growth_rate_linearized,
+               "nutation_frequency_rad_s": ntc.nutation_frequency,
+               "relative_difference": ntc.relative_difference, "grows": ntc.grows}
+        with open(args.json, "w", encoding="utf-8") as fh:
+            json.dump(out, fh, indent=2)
+            fh.write("\n")
+    if ntc.relative_difference > 0.02:
+        print("warning: the two methods differ by more than 2 %; simulate longer "
+              "([ntc] duration) or with a smaller initial_rate", file=sys.stderr)
+    return 0

@@ -1,0 +1,52 @@
+"""``slosh simulate``: the analog's response to a test case's excitation."""
+
+from __future__ import annotations
+
+import argparse
+from pathlib import Path
+
+from ._outputs import refuse_existing
+
+__all__ = ["add_parser"]
+
+
+def add_parser(sub: argparse._SubParsersAction) -> None:
+    p = sub.add_parser(
+        "simulate", help="simulate a model for a test case's excitation",
+        description="Simulate the analog model for the excitation of CASE.toml and write "
+                    "time,force (N) to a CSV file.")
+    p.add_argument("case", help="test case file (TOML)")
+    p.add_argument("--params", required=True,
+                   help="JSON parameter values: a flat map {\"p1.mass\": 1.3, ...} or a fit result")
+    p.add_argument("--out", required=True, help="output CSV (time,force)")
+    p.add_argument("--model", default=None,
+                   help="model specification, e.g. 'fixed,p1,p2' (default: fixed,p1 with hinge "
+                        "spring and damper)")
+    p.add_argument("--integrator", choices=("rk4", "adaptive"), default="rk4",
+                   help="fixed-step RK4 on the sample grid (default) or CVODES")
+    p.add_argument("--overwrite", action="store_true", help="replace an existing --out file")
+    p.set_defaults(run=run)
+
+
+def run(args: argparse.Namespace) -> int:
+    import numpy as np
+
+    from derive import RK4, Adaptive
+
+    from ..data import load_case
+    from ..data.experiment import experiment
+    from ..data.models import BASELINE, model_from_spec
+    from ..fitting.params_io import read_params
+
+    out = Path(args.out)
+    refuse_existing([out], args.overwrite)
+    case = load_case(args.case)
+    params = read_params(args.params)
+    exp = experiment(case, model_from_spec(args.model or BASELINE, case))
+    integrator = RK4() if args.integrator == "rk4" else Adaptive()
+    sim = exp.simulate(params, integrator=integrator)
+    columns = {"time": sim.time, "force": sim.output("force_x")}
+    np.savetxt(out, np.column_stack(list(columns.values())), delimiter=",",
+               header=",".join(columns), comments="", fmt="%.12g")
+    print(f"wrote {out} ({sim.time.size} samples, model {', '.join(exp.model.names)})")
+    return 0

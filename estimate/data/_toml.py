@@ -1,0 +1,265 @@
+"""Validation of the TOML tables of a case file: every problem is collected, none raised."""
+
+from __future__ import annotations
+
+import math
+from collections.abc import Mapping
+from typing import Any
+
+from .case import (
+    KNOWN_EXCITATIONS,
+    KNOWN_RIGS,
+    KNOWN_SHAPES,
+    TANK_AXES,
+    Crank,
+    Liquid,
+    Prediction,
+    Rig,
+    Spin,
+    Tank,
+    TestInfo,
+)
+
+__all__ = ["Checker", "read_tables"]
+
+
+class Checker:
+    """Collects problems while reading one TOML document."""
+
+    def __init__(self, filename: str) -> None:
+        self.filename = filename
+        self.problems: list[str] = []
+
+    def add(self, where: str, message: str) -> None:
+        self.problems.append(f"{self.filename}: {where}: {message}")
+
+    def table(self, doc: Mapping[str, Any], name: str, *, required: bool) -> Mapping[str, Any] | None:
+        parts = name.split(".")
+        node: Any = doc
+        for part in parts:
+            if not isinstance(node, Mapping) or part not in node:
+                if required:
+                    self.add(f"[{name}]", "missing table (expected a `[" + name + "]` section)")
+                return None
+            node = node[part]
+        if not isinstance(node, Mapping):
+            self.add(f"[{name}]", f"expected a table, found {_type_name(node)} `{node!r}`")
+            return None
+        return node
+
+    def string(self, table: Mapping[str, Any], tname: str, key: str, *,
+               choices: tuple[str, ...] | None = None, required: bool = True) -> str | None:
+        where = f"[{tname}] {key}"
+        if key not in table:
+            if required:
+                self.add(where, "missing key (expected a string)")
+            return None
+        value = table[key]
+        if not isinstance(value, str):
+            self.add(where, f"expected a string, found {_type_name(value)} `{value!r}`")
+            return None
+        if choices is not None and value not in choices:
+            allowed = ", ".join(f'"{c}"' for c in choices)
+            self.add(where, f'unknown value "{value}" (expected one of {allowed})')
+            return None
+        return value
+
+    def boolean(self, table: Mapping[str, Any], tname: str, key: str) -> bool | None:
+        where = f"[{tname}] {key}"
+        if key not in table:
+            self.add(where, "missing key (expected true or false)")
+            return None
+        value = table[key]
+        if not isinstance(value, bool):
+            self.add(where, f"expected true or false, found {_type_name(value)} `{value!r}`")
+            return None
+        return value
+
+    def number(self, table: Mapping[str, Any], tname: str, key: str, *, unit: str,
+               positive: bool = False, nonnegative: bool = False,
+               open_unit_interval: bool = False) -> float | None:
+        where = f"[{tname}] {key}"
+        if key not in table:
+            self.add(where, f"missing key (expected a number in {unit})")
+            return None
+        value = table[key]
+        # bool is an int subclass in Python; TOML true/false is never a valid number.
+        if isinstance(value, bool) or not isinstance(value, (int, float)):
+            self.add(where, f"expected a number in {unit}, found {_type_name(value)} `{value!r}`")
+            return None
+        number = float(value)
+        if not math.isfinite(number):
+            self.add(where, f"expected a finite number in {unit}, found {value!r}")
+            return None
+        if positive and not number > 0.0:
+            self.add(where, f"expected a positive number in {unit}, found {value!r}")
+            return None
+        if nonnegative and not number >= 0.0:
+            self.add(where, f"expected a number >= 0 in {unit}, found {value!r}")
+            return None
+        if open_unit_interval and not 0.0 < number < 1.0:
+            self.add(where, f"expected a number strictly between 0 and 1, found {value!r}")
+            return None
+        return number
+
+
+def _type_name(value: Any) -> str:
+    names = {bool: "a boolean", int: "an integer", float: "a float", str: "a string",
+             list: "an array", dict: "a table"}
+    return names.get(type(value), type(value).__name__)
+
+
+def _read_test(ck: Checker, doc: Mapping[str, Any]) -> TestInfo | None:
+    t = ck.table(doc, "test", required=True)
+    if t is None:
+        return None
+    test_id = ck.string(t, "test", "id")
+    rig = ck.string(t, "test", "rig", choices=KNOWN_RIGS)
+    data = ck.string(t, "test", "data")
+    spinning = rig == "spinning"
+    excitation = ck.string(t, "test", "excitation",
+                           choices=("spin",) if spinning else ("measured", "crank"),
+                           required=not spinning)
+    if spinning and "excitation" not in t:
+        excitation = "spin"  # the spinning rig's motion comes from `[rig.spin]`
+    note = ck.string(t, "test", "note", required=False)
+    if data is not None and not data.strip():
+        ck.add("[test] data", 'expected a CSV path, found an empty string ""')
+        data = None
+    if None in (test_id, rig, data, excitation):
+        return None
+    assert test_id is not None and rig is not None and data is not None
+    assert excitation is not None
+    return TestInfo(id=test_id, rig=rig, data=data, excitation=excitation, note=note)
+
+
+def _read_tank(ck: Checker, doc: Mapping[str, Any]) -> Tank | None:
+    t = ck.table(doc, "tank", required=True)
+    if t is None:
+        return None
+    shape = ck.string(t, "tank", "shape", choices=KNOWN_SHAPES)
+    radius = ck.number(t, "tank", "radius", unit="m", positive=True)
+    fill = ck.number(t, "tank", "fill_fraction", unit="-", open_unit_interval=True)
+    diaphragm = ck.boolean(t, "tank", "diaphragm")
+    if shape is None or radius is None or fill is None or diaphragm is None:
+        return None
+    return Tank(shape=shape, radius=radius, fill_fraction=fill, diaphragm=diaphragm)
+
+
+def _read_liquid(ck: Checker, doc: Mapping[str, Any]) -> Liquid | None:
+    t = ck.table(doc, "liquid", required=True)
+    if t is None:
+        return None
+    density = ck.number(t, "liquid", "density", unit="kg/m^3", positive=True)
+    nu = ck.number(t, "liquid", "kinematic_viscosity", unit="m^2/s", positive=True)
+    if density is None or nu is None:
+        return None
+    return Liquid(density=density, kinematic_viscosity=nu)
+
+
+def _read_crank(ck: Checker, doc: Mapping[str, Any], *, required: bool) -> tuple[bool, Crank | None]:
+    """Return (table present, crank or None)."""
+    rig = doc.get("rig")
+    present = isinstance(rig, Mapping) and "crank" in rig
+    if not present:
+        if required:
+            ck.add("[rig.crank]", 'missing table (expected `[rig.crank]` with radius, rod_length '
+                   'and frequency because `[test] excitation = "crank"`)')
+        return False, None
+    t = ck.table(doc, "rig.crank", required=True)
+    if t is None:
+        return True, None
+    radius = ck.number(t, "rig.crank", "radius", unit="m", positive=True)
+    rod = ck.number(t, "rig.crank", "rod_length", unit="m", positive=True)
+    freq = ck.number(t, "rig.crank", "frequency", unit="Hz", positive=True)
+    if radius is not None and rod is not None and not rod > radius:
+        ck.add("[rig.crank] rod_length",
+               f"expected a rod longer than the crank radius ({radius!r} m), found {rod!r} m")
+        rod = None
+    if radius is None or rod is None or freq is None:
+        return True, None
+    return True, Crank(radius=radius, rod_length=rod, frequency=freq)
+
+
+def _read_spin(ck: Checker, doc: Mapping[str, Any], *, required: bool) -> tuple[bool, Spin | None]:
+    """Return (table present, spin or None)."""
+    rig = doc.get("rig")
+    present = isinstance(rig, Mapping) and "spin" in rig
+    if not present:
+        if required:
+            ck.add("[rig.spin]", 'missing table (expected `[rig.spin]` with rate, radius, '
+                   'nutation_angle and nutation_frequency because `[test] rig = "spinning"`)')
+        return False, None
+    t = ck.table(doc, "rig.spin", required=True)
+    if t is None:
+        return True, None
+    rate = ck.number(t, "rig.spin", "rate", unit="rad/s")
+    radius = ck.number(t, "rig.spin", "radius", unit="m", nonnegative=True)
+    angle = ck.number(t, "rig.spin", "nutation_angle", unit="rad", nonnegative=True)
+    if angle is not None and not angle < math.pi / 2:
+        ck.add("[rig.spin] nutation_angle",
+               f"expected a cone half-angle below pi/2 rad, found {angle!r} rad")
+        angle = None
+    freq = ck.number(t, "rig.spin", "nutation_frequency", unit="Hz")
+    height = ck.number(t, "rig.spin", "height", unit="m") if "height" in t else 0.0
+    axis = ck.string(t, "rig.spin", "tank_axis", choices=TANK_AXES, required=False)
+    gravity_on = ck.boolean(t, "rig.spin", "gravity_on") if "gravity_on" in t else True
+    if None in (rate, radius, angle, freq, height, gravity_on) or ("tank_axis" in t and axis is None):
+        return True, None
+    assert rate is not None and radius is not None and angle is not None and freq is not None
+    assert height is not None and gravity_on is not None
+    return True, Spin(rate=rate, radius=radius, nutation_angle=angle, nutation_frequency=freq,
+                      height=height, tank_axis=axis or "spin", gravity_on=gravity_on)
+
+
+def _read_rig(ck: Checker, doc: Mapping[str, Any], excitation: str | None,
+              rig_kind: str | None = None) -> Rig | None:
+    t = ck.table(doc, "rig", required=True)
+    dry = grav = None
+    if t is not None:
+        dry = ck.number(t, "rig", "dry_mass", unit="kg", positive=True)
+        grav = ck.number(t, "rig", "gravity", unit="m/s^2", positive=True)
+    present, crank = _read_crank(ck, doc, required=(excitation == "crank" and t is not None))
+    spinning = rig_kind == "spinning"
+    spin_present, spin = _read_spin(ck, doc, required=spinning and t is not None)
+    if dry is None or grav is None or (present and crank is None):
+        return None
+    if excitation == "crank" and crank is None:
+        return None
+    if spin_present and spin is None or (spinning and spin is None):
+        return None
+    return Rig(dry_mass=dry, gravity=grav, crank=crank, spin=spin if spinning else None)
+
+
+def _read_prediction(ck: Checker, doc: Mapping[str, Any]) -> tuple[bool, Prediction | None]:
+    if "prediction" not in doc:
+        return False, None
+    t = ck.table(doc, "prediction", required=True)
+    if t is None:
+        return True, None
+    pm = ck.number(t, "prediction", "pendulum_mass", unit="kg", positive=True)
+    pl = ck.number(t, "prediction", "pendulum_length", unit="m", positive=True)
+    fm = ck.number(t, "prediction", "fixed_mass", unit="kg", positive=True)
+    zeta = ck.number(t, "prediction", "damping_ratio", unit="- (fraction of critical)",
+                     nonnegative=True)
+    if pm is None or pl is None or fm is None or zeta is None:
+        return True, None
+    return True, Prediction(pendulum_mass=pm, pendulum_length=pl, fixed_mass=fm,
+                            damping_ratio=zeta)
+
+
+def read_tables(ck: Checker, doc: Mapping[str, Any]):
+    """All tables of ``doc``: ``(test, tank, liquid, rig, prediction_present, prediction)``;
+    a table with problems is ``None`` (the problems are in ``ck``)."""
+    test = _read_test(ck, doc)
+    t_table = doc.get("test")
+    excitation = None
+    if isinstance(t_table, Mapping) and t_table.get("excitation") in KNOWN_EXCITATIONS:
+        excitation = t_table["excitation"]
+    rig_kind = t_table.get("rig") if isinstance(t_table, Mapping) else None
+    rig_kind = rig_kind if rig_kind in KNOWN_RIGS else None
+    tank = _read_tank(ck, doc)
+    liquid = _read_liquid(ck, doc)
+    rig = _read_rig(ck, doc, excitation, rig_kind)
+    pred_present, prediction = _read_prediction(ck, doc)
+    return test, tank, liquid, rig, pred_present, prediction

@@ -1,0 +1,378 @@
+"""Test-case files: a TOML description plus a CSV of samples.
+
+A case file describes one tank test (tank, liquid, rig, optional analog prediction) and names a
+CSV file with the measured samples. The format is the one of the estimation issue::
+
+    [test]
+    id = "A1"
+    rig = "lateral"              # "lateral" now; "spinning" later
+    data = "A1.csv"              # CSV path relative to this file
+    excitation = "measured"      # "measured": CSV has displacement; "crank": from [rig.crank]
+
+    [tank]
+    shape = "sphere"             # "sphere" | "cylinder"
+    radius = 0.1016              # m
+    fill_fraction = 0.6          # liquid depth / tank height
+    diaphragm = false
+
+    [liquid]
+    density = 998.2              # kg/m^3
+    kinematic_viscosity = 1.004e-6   # m^2/s
+
+    [rig]
+    dry_mass = 1.2               # kg
+    gravity = 9.80665            # m/s^2
+
+    [rig.crank]                  # only for excitation = "crank"
+    radius = 0.01                # m
+    rod_length = 0.15            # m
+    frequency = 1.855            # Hz
+
+    [prediction]                 # optional
+    pendulum_mass = 1.338        # kg
+    pendulum_length = 0.057      # m
+    fixed_mass = 1.456           # kg
+    damping_ratio = 0.00703      # fraction of critical
+
+The CSV header is ``time,displacement,force`` (s, m, N); ``displacement`` may be absent when
+``excitation = "crank"``. Keys not listed above are allowed and ignored (``[test] note`` is kept).
+
+Spinning rig
+------------
+``rig = "spinning"`` describes the Spinning Slosh Test Rig (:class:`analogs.SpinningRig`): the
+rig motion is prescribed by a ``[rig.spin]`` table, so ``[test] excitation`` may be omitted
+(it is then ``"spin"``, the only value accepted for this rig)::
+
+    [rig.spin]
+    rate = 6.0                   # rad/s, table spin rate
+    radius = 0.4                 # m, tank origin from the spin axis
+    nutation_angle = 0.06        # rad, cone half-angle of the table axis
+    nutation_frequency = 0.3     # Hz, coning frequency (either sign)
+    height = 0.3                 # m, optional (default 0): tank origin above the pivot
+    tank_axis = "spin"           # optional: "spin" (default) or "inward"
+    gravity_on = true            # optional (default true): gravity acts
+
+Its CSV has the columns ``time,force_x,force_y,force_z,torque_x,torque_y,torque_z`` (s, N,
+N m; tank-frame components, torques about the mount point), in any order after ``time``;
+extra columns (e.g. measured rig angles) are allowed, kept in :attr:`Case.channels` and
+checked like the others.
+
+:func:`load_case` (:mod:`estimate.data.reader`) validates everything and raises one
+:class:`CaseError` listing every problem; input files are never modified. :func:`write_case`
+writes a case (TOML + CSV), e.g. for generated data, and refuses to overwrite existing files
+unless asked to.
+
+Validation limits
+-----------------
+* Time must increase strictly and be uniform: every step must be within
+  :data:`TIME_STEP_RTOL` (1e-3) of the median step, relative. This admits timestamps printed
+  with a few decimals and floating-point round-off, and rejects dropped or repeated samples
+  (a dropped sample is a 100% step error).
+* At least :data:`MIN_SAMPLES` (50) samples: fewer cannot hold a few periods of a 1-5 Hz drive at
+  100 Hz sampling, nor the padding that zero-phase filters and Welch spectra need.
+* CSV problems name the line of the file (the header is line 1).
+"""
+
+from __future__ import annotations
+
+from collections.abc import Mapping
+from dataclasses import dataclass, field
+from pathlib import Path
+
+import numpy as np
+from numpy.typing import NDArray
+
+from analogs.errors import InputError
+
+__all__ = [
+    "KNOWN_EXCITATIONS",
+    "KNOWN_RIGS",
+    "KNOWN_SHAPES",
+    "MIN_SAMPLES",
+    "TIME_STEP_RTOL",
+    "Case",
+    "CaseError",
+    "Crank",
+    "Liquid",
+    "Prediction",
+    "Rig",
+    "SPINNING_CHANNELS",
+    "Spin",
+    "Tank",
+    "TestInfo",
+]
+
+KNOWN_RIGS: tuple[str, ...] = ("lateral", "spinning")
+"""Values accepted for ``[test] rig``."""
+KNOWN_EXCITATIONS: tuple[str, ...] = ("measured", "crank", "spin")
+"""Values accepted for ``[test] excitation`` (``"spin"``: only, and by default, for the
+spinning rig)."""
+SPINNING_CHANNELS: tuple[str, ...] = ("force_x", "force_y", "force_z",
+                                      "torque_x", "torque_y", "torque_z")
+"""Columns a spinning-rig CSV must have besides ``time`` (N and N m)."""
+TANK_AXES: tuple[str, ...] = ("spin", "inward")
+"""Values accepted for ``[rig.spin] tank_axis``."""
+KNOWN_SHAPES: tuple[str, ...] = ("sphere", "cylinder")
+"""Values accepted for ``[tank] shape``."""
+MIN_SAMPLES: int = 50
+"""Minimum number of CSV samples (see the module docstring for why)."""
+TIME_STEP_RTOL: float = 1e-3
+"""Allowed deviation of each time step from the median step, relative to the median step."""
+
+
+
+class CaseError(InputError):
+    """A case file (TOML or CSV) is invalid.
+
+    Parameters
+    ----------
+    problems : list of str
+        One message per problem, each naming the file, the key or column and row, what was
+        expected and what was found.
+
+    Attributes
+    ----------
+    problems : list of str
+        The individual problems, in the order they were found.
+    """
+
+    def __init__(self, problems: list[str]) -> None:
+        self.problems: list[str] = list(problems)
+        count = len(self.problems)
+        head = f"{count} problem{'s' if count != 1 else ''} in case:"
+        super().__init__("\n".join([head, *(f"  - {p}" for p in self.problems)]))
+
+
+@dataclass(frozen=True)
+class TestInfo:
+    """The ``[test]`` table.
+
+    Attributes
+    ----------
+    id : str
+        Test identifier, e.g. ``"A1"``.
+    rig : str
+        Rig kind, one of :data:`KNOWN_RIGS`.
+    data : str
+        CSV path as written in the file (relative to the TOML file unless absolute).
+    excitation : str
+        ``"measured"`` (CSV has the carriage displacement) or ``"crank"`` (from
+        ``[rig.crank]``).
+    note : str or None
+        Free text, e.g. that the data are synthetic.
+    """
+
+    __test__ = False  # not a pytest test class despite the name
+
+    id: str
+    rig: str
+    data: str
+    excitation: str
+    note: str | None = None
+
+
+@dataclass(frozen=True)
+class Tank:
+    """The ``[tank]`` table.
+
+    Attributes
+    ----------
+    shape : str
+        One of :data:`KNOWN_SHAPES`.
+    radius : float
+        Tank radius [m].
+    fill_fraction : float
+        Liquid depth / tank height, in (0, 1) [-].
+    diaphragm : bool
+        Whether the tank has an elastomeric diaphragm.
+    """
+
+    shape: str
+    radius: float
+    fill_fraction: float
+    diaphragm: bool
+
+
+@dataclass(frozen=True)
+class Liquid:
+    """The ``[liquid]`` table.
+
+    Attributes
+    ----------
+    density : float
+        [kg/m^3].
+    kinematic_viscosity : float
+        [m^2/s].
+    """
+
+    density: float
+    kinematic_viscosity: float
+
+
+@dataclass(frozen=True)
+class Crank:
+    """The ``[rig.crank]`` table: crank ("locomotive arm") drive of the carriage.
+
+    The carriage displacement is ``x = r cos(phi) + sqrt(l^2 - r^2 sin(phi)^2) - l`` with
+    flywheel angle ``phi = phi0 + (2 pi frequency + dOmega) t``.
+
+    Attributes
+    ----------
+    radius : float
+        Crank radius r [m].
+    rod_length : float
+        Connecting-rod length l [m], larger than ``radius``.
+    frequency : float
+        Nominal drive frequency [Hz].
+    """
+
+    radius: float
+    rod_length: float
+    frequency: float
+
+
+@dataclass(frozen=True)
+class Spin:
+    """The ``[rig.spin]`` table: prescribed motion of the spinning rig
+    (:class:`analogs.SpinningRig`).
+
+    Attributes
+    ----------
+    rate : float
+        Table spin rate [rad/s].
+    radius : float
+        Distance of the tank origin (mount point) from the spin axis [m], >= 0.
+    nutation_angle : float
+        Half-angle of the cone swept by the table axis [rad], in [0, pi/2).
+    nutation_frequency : float
+        Coning frequency of the table axis [Hz] (positive: with the spin).
+    height : float, default 0
+        Height of the tank origin above the nutation pivot along the spin axis [m].
+    tank_axis : str, default "spin"
+        ``"spin"`` or ``"inward"`` (see :class:`analogs.SpinningRig`).
+    gravity_on : bool, default True
+        Whether gravity acts (``[rig] gravity`` gives its value).
+    """
+
+    rate: float
+    radius: float
+    nutation_angle: float
+    nutation_frequency: float
+    height: float = 0.0
+    tank_axis: str = "spin"
+    gravity_on: bool = True
+
+
+@dataclass(frozen=True)
+class Rig:
+    """The ``[rig]`` table.
+
+    Attributes
+    ----------
+    dry_mass : float
+        Mass moving with the tank and seen by the force transducer [kg].
+    gravity : float
+        Gravitational acceleration [m/s^2].
+    crank : Crank or None
+        The ``[rig.crank]`` table when present.
+    spin : Spin or None
+        The ``[rig.spin]`` table (spinning rig only).
+    """
+
+    dry_mass: float
+    gravity: float
+    crank: Crank | None = None
+    spin: Spin | None = None
+
+
+@dataclass(frozen=True)
+class Prediction:
+    """The optional ``[prediction]`` table: analog parameters a slosh code predicted.
+
+    Attributes
+    ----------
+    pendulum_mass : float
+        [kg].
+    pendulum_length : float
+        [m].
+    fixed_mass : float
+        [kg].
+    damping_ratio : float
+        Fraction of critical damping [-], >= 0.
+    """
+
+    pendulum_mass: float
+    pendulum_length: float
+    fixed_mass: float
+    damping_ratio: float
+
+
+@dataclass(frozen=True, eq=False)
+class Case:
+    """A validated test case.
+
+    The arrays are read-only copies.
+
+    Attributes
+    ----------
+    path : pathlib.Path
+        The TOML file, resolved.
+    data_path : pathlib.Path
+        The CSV file, resolved.
+    test, tank, liquid, rig, prediction
+        The tables of the TOML file (``prediction`` is None when absent).
+    time : numpy.ndarray
+        Sample times [s], strictly increasing and uniform.
+    displacement : numpy.ndarray or None
+        Carriage displacement [m]; None when the CSV has no displacement column.
+    force : numpy.ndarray or None
+        Measured lateral force [N] (lateral rig); None for the spinning rig.
+    columns : mapping of str to numpy.ndarray
+        The CSV columns besides ``time`` of a spinning-rig case (empty for a lateral case);
+        read them through :attr:`channels`.
+    """
+
+    path: Path
+    data_path: Path
+    test: TestInfo
+    tank: Tank
+    liquid: Liquid
+    rig: Rig
+    prediction: Prediction | None
+    time: NDArray[np.float64] = field(repr=False)
+    displacement: NDArray[np.float64] | None = field(repr=False)
+    force: NDArray[np.float64] | None = field(repr=False)
+    columns: Mapping[str, NDArray[np.float64]] = field(default_factory=dict, repr=False)
+
+    @property
+    def channels(self) -> dict[str, NDArray[np.float64]]:
+        """Measured signals by output name: ``{"force_x": force}`` for the lateral rig, the
+        six force/torque channels (and any extra CSV columns) for the spinning rig."""
+        if self.test.rig == "lateral":
+            return {} if self.force is None else {"force_x": self.force}
+        return dict(self.columns)
+
+    @property
+    def spin(self) -> Spin | None:
+        """The ``[rig.spin]`` table, or None."""
+        return self.rig.spin
+
+    @property
+    def crank(self) -> Crank | None:
+        """The ``[rig.crank]`` table, or None."""
+        return self.rig.crank
+
+    @property
+    def sample_interval(self) -> float:
+        """Median time step [s]."""
+        return float(np.median(np.diff(self.time)))
+
+    @property
+    def sample_rate(self) -> float:
+        """Sampling rate [Hz]."""
+        return 1.0 / self.sample_interval
+
+    @property
+    def n_samples(self) -> int:
+        """Number of samples."""
+        return int(self.time.size)

@@ -1,0 +1,128 @@
+"""Analog models for test cases: the baseline, model specifications (``--model``) and the
+rig values a case file fixes."""
+
+from __future__ import annotations
+
+from analogs import (
+    DiaphragmSpring,
+    FixedMass,
+    HingeDamper,
+    HingeSpring,
+    LateralRig,
+    Model,
+    Pendulum,
+    QuadraticDamper,
+    Rotor,
+    SphericalPendulum,
+    SpinningRig,
+)
+from analogs.component import Rig
+from analogs.errors import InputError
+
+from .case import Case
+
+__all__ = ["BASELINE", "ROTOR_AXIS", "model_from_spec", "rig_for", "rig_values"]
+
+#: Tank axis of rotor analogs on the spinning rig: ``T.y``, the tangential direction (the
+#: way the tank origin moves), about which the nutation drives a rotor (the spin-axis
+#: component of the tank's angular acceleration is zero, see :class:`analogs.SpinningRig`).
+ROTOR_AXIS = "y"
+
+#: The default model of ``slosh simulate`` and ``slosh fit``: fixed mass + first-mode
+#: pendulum with hinge spring and linear hinge damper.
+BASELINE = "fixed,p1"
+
+_MODIFIERS = {
+    "nospring": "pendulum without hinge spring",
+    "quadratic": "adds a QuadraticDamper",
+    "diaphragm": "adds a DiaphragmSpring",
+}
+
+
+def rig_for(case: Case) -> Rig:
+    """The rig of ``case``: :class:`analogs.LateralRig` (measured or crank excitation) or
+    :class:`analogs.SpinningRig` (``[rig.spin]`` gives its tank axis and whether gravity
+    acts)."""
+    if case.test.rig == "spinning":
+        spin = case.rig.spin
+        if spin is None:
+            raise InputError(f"{case.path}: `rig = \"spinning\"` needs a `[rig.spin]` table")
+        return SpinningRig(gravity=spin.gravity_on, tank_axis=spin.tank_axis)
+    if case.test.rig != "lateral":
+        raise InputError(f"{case.path}: [test] rig = {case.test.rig!r} is not supported; "
+                         "expected 'lateral' or 'spinning'")
+    return LateralRig(excitation=case.test.excitation)
+
+
+def rig_values(case: Case) -> dict[str, float]:
+    """Parameter values the case file fixes: dry mass, gravity and the crank geometry, or
+    the spinning rig's motion (``[rig.spin]`` -> ``rig.spin_rate``, ``rig.radius``,
+    ``rig.height``, ``rig.nutation_angle``, ``rig.nutation_frequency``)."""
+    spin = case.rig.spin
+    if case.test.rig == "spinning" and spin is not None:
+        out = {"rig.dry_mass": case.rig.dry_mass, "rig.spin_rate": spin.rate,
+               "rig.radius": spin.radius, "rig.height": spin.height,
+               "rig.nutation_angle": spin.nutation_angle,
+               "rig.nutation_frequency": spin.nutation_frequency}
+        if spin.gravity_on:
+            out["rig.gravity"] = case.rig.gravity
+        return out
+    out = {"rig.dry_mass": case.rig.dry_mass, "rig.gravity": case.rig.gravity}
+    if case.test.excitation == "crank" and case.crank is not None:
+        out |= {"rig.crank_radius": case.crank.radius, "rig.rod_length": case.crank.rod_length,
+                "rig.drive_frequency": case.crank.frequency}
+    return out
+
+
+def model_from_spec(spec: str, case: Case) -> Model:
+    """Build a model from a comma-separated specification such as ``"fixed,p1,p2"``.
+
+    Tokens: ``fixed`` (FixedMass); ``pN`` (Pendulum with HingeSpring and HingeDamper;
+    on the spinning rig a SphericalPendulum), optionally with modifiers after colons:
+    ``pN:nospring`` (no hinge spring), ``pN:quadratic`` (adds a QuadraticDamper),
+    ``pN:diaphragm`` (adds a DiaphragmSpring); spinning rig only: ``rotor`` or ``rN``
+    (a Rotor about the tangential tank axis :data:`ROTOR_AXIS`, coupled by a viscous damper).
+
+    Examples
+    --------
+    >>> model = model_from_spec("fixed,p1:nospring,r1", spinning_case)   # doctest: +SKIP
+    """
+    model: Model = Model((rig_for(case),))
+    spinning = case.test.rig == "spinning"
+    problems = []
+    tokens = [tok.strip() for tok in spec.replace("+", ",").split(",") if tok.strip()]
+    if not tokens:
+        problems.append("empty model specification")
+    for tok in tokens:
+        name, *mods = tok.split(":")
+        unknown = [m for m in mods if m not in _MODIFIERS]
+        if unknown:
+            problems.append(f"{tok!r}: unknown modifier {', '.join(map(repr, unknown))}; known: "
+                            + ", ".join(f"{k} ({v})" for k, v in _MODIFIERS.items()))
+            continue
+        if name == "fixed":
+            if mods:
+                problems.append(f"{tok!r}: `fixed` takes no modifiers")
+            model = model + FixedMass("fixed")
+        elif name == "rotor" or (name.startswith("r") and name[1:].isdigit()):
+            if not spinning:
+                problems.append(f"{tok!r}: a rotor needs a rig that rotates (`rig = \"spinning\"`)")
+            elif mods:
+                problems.append(f"{tok!r}: a rotor takes no modifiers")
+            else:
+                model = model + Rotor(name, axis=ROTOR_AXIS)
+        elif name.startswith("p") and name[1:].isdigit():
+            pend = SphericalPendulum(name) if spinning else Pendulum(name)
+            model = model + pend + HingeDamper(name)
+            if "nospring" not in mods:
+                model = model + HingeSpring(name)
+            if "quadratic" in mods:
+                model = model + QuadraticDamper(name)
+            if "diaphragm" in mods:
+                model = model + DiaphragmSpring(name)
+        else:
+            problems.append(f"{tok!r}: unknown component; expected `fixed`, `pN` (p1, p2, ...)"
+                            + (" or `rotor`/`rN`" if spinning else ""))
+    if problems:
+        raise InputError(f"--model {spec!r}: " + "; ".join(problems))
+    return model.validate()

@@ -1,0 +1,98 @@
+"""``load_case``: a case file (TOML) and the CSV it names, validated at once."""
+
+from __future__ import annotations
+
+import os
+import tomllib
+from collections.abc import Mapping
+from pathlib import Path
+
+from ._csv import read_csv
+from ._toml import Checker, read_tables
+from .case import KNOWN_EXCITATIONS, KNOWN_RIGS, Case, CaseError
+
+__all__ = ["load_case"]
+
+
+def load_case(path: str | os.PathLike[str]) -> Case:
+    """Load and validate a test case (TOML file plus the CSV it names).
+
+    Parameters
+    ----------
+    path : str or path-like
+        The TOML case file.
+
+    Returns
+    -------
+    Case
+        Frozen case with read-only arrays ``time`` [s], ``displacement`` [m] (or None) and
+        ``force`` [N].
+
+    Raises
+    ------
+    CaseError
+        Listing every problem found in the TOML and CSV files at once.
+
+    Examples
+    --------
+    >>> from estimate.data import load_case
+    >>> case = load_case("examples/A1.toml")            # doctest: +SKIP
+    >>> case.rig.dry_mass, case.n_samples               # doctest: +SKIP
+    (1.2, 3001)
+    """
+    toml_path = Path(path)
+    fname = toml_path.name
+    try:
+        raw = toml_path.read_bytes()
+    except FileNotFoundError:
+        raise CaseError([f"{fname}: case file not found (expected a TOML file at "
+                         f"`{toml_path}`)"]) from None
+    except OSError as exc:
+        raise CaseError([f"{fname}: cannot read the case file ({exc.strerror or exc})"]) from None
+    try:
+        doc = tomllib.loads(raw.decode("utf-8"))
+    except UnicodeDecodeError as exc:
+        raise CaseError([f"{fname}: expected a UTF-8 TOML file, found undecodable bytes "
+                         f"({exc})"]) from None
+    except tomllib.TOMLDecodeError as exc:
+        raise CaseError([f"{fname}: invalid TOML: {exc}"]) from None
+
+    ck = Checker(fname)
+    test, tank, liquid, rig, pred_present, prediction = read_tables(ck, doc)
+    t_table = doc.get("test")
+    excitation = None
+    if isinstance(t_table, Mapping) and t_table.get("excitation") in KNOWN_EXCITATIONS:
+        excitation = t_table["excitation"]
+    rig_kind = t_table.get("rig") if isinstance(t_table, Mapping) else None
+    rig_kind = rig_kind if rig_kind in KNOWN_RIGS else None
+
+    problems = ck.problems
+    arrays = None
+    data_path: Path | None = None
+    data_name = t_table.get("data") if isinstance(t_table, Mapping) else None
+    if isinstance(data_name, str) and data_name.strip():
+        data_path = Path(data_name)
+        if not data_path.is_absolute():
+            data_path = toml_path.parent / data_path
+        if not data_path.is_file():
+            problems.append(f"{fname}: [test] data: data file not found (expected a CSV file "
+                            f"at `{data_path}`)")
+        else:
+            csv_problems: list[str] = []
+            arrays = read_csv(data_path, excitation, csv_problems, rig_kind)
+            problems.extend(csv_problems)
+
+    if problems:
+        raise CaseError(problems)
+    assert test is not None and tank is not None and liquid is not None and rig is not None
+    assert arrays is not None and data_path is not None
+    assert not (pred_present and prediction is None)
+    time, disp, force, columns = arrays
+    for arr in (time, disp, force, *columns.values()):
+        if arr is not None:
+            arr.flags.writeable = False
+    return Case(path=toml_path.resolve(), data_path=data_path.resolve(), test=test, tank=tank,
+                liquid=liquid, rig=rig, prediction=prediction, time=time, displacement=disp,
+                force=force, columns=columns)
+
+

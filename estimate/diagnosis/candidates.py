@@ -1,0 +1,349 @@
+"""Candidate extensions of an analog model, each a declared component or measurement
+model, with its initial values from the evidence and a physical plausibility check."""
+
+from __future__ import annotations
+
+import math
+from collections.abc import Callable, Mapping
+from dataclasses import dataclass, field
+
+from analogs import HingeDamper, HingeSpring, Model, Pendulum, QuadraticDamper
+
+from ..fitting.measurement import MeasurementModel, RigFriction, SensorDelay
+from ..fitting.result import FitResult
+from .evidence import Evidence
+
+__all__ = ["Proposal", "propose", "CAUSES"]
+
+#: The causes a diagnosis can name.
+CAUSES = ("slosh_mode", "nonlinear_damping", "diaphragm_stiffness", "sensor_delay",
+          "rig_friction", "rotor")
+
+
+@dataclass(frozen=True)
+class Proposal:
+    """One candidate: the extended model and measurement models, initial values and bounds
+    over the current estimates, what it adds, and (for a sensor delay) the delay range to
+    profile. ``plausible(result)`` returns ``None`` or the reason it is not physical."""
+
+    cause: str
+    added: tuple[str, ...]
+    model: Model
+    measurement: tuple[MeasurementModel, ...]
+    initial: Mapping[str, float]
+    bounds: Mapping[str, tuple[float, float]] = field(default_factory=dict)
+    hold: Mapping[str, float] = field(default_factory=dict)
+    delay_range: tuple[float, float] | None = None
+    plausible: Callable[[FitResult], str | None] = field(default=lambda r: None, repr=False)
+    describe: Callable[[FitResult], str] = field(default=lambda r: "", repr=False)
+
+
+def _has(model: Model, cls, name: str) -> bool:
+    return any(isinstance(c, cls) and c.name == name for c in model.components)
+
+
+def _pendulums(model: Model) -> list[str]:
+    return [c.name for c in model.components if isinstance(c, Pendulum)]
+
+
+def _significant(res: FitResult, name: str, factor: float = 2.0) -> bool:
+    return name in res.names and res.value(name) > factor * res.stderr[res.names.index(name)]
+
+
+def _freq(res: FitResult, name: str) -> float:
+    return res.derived.get(f"{name}.frequency_hz", (math.nan, 0))[0]
+
+
+def _probe_regression(probe, J, r):
+    """Regress the residual ``r`` on a unit probe response and the fit's sensitivity ``J``
+    (one Gauss-Newton step of the extended model). Returns the probe's size (the residual is
+    simulated - measured, so a missing element enters with minus its size) and the explained
+    fraction of the residual."""
+    import numpy as np
+
+    A = np.column_stack([probe, J])
+    coef, *_ = np.linalg.lstsq(A, r, rcond=None)
+    explained = 1 - float(np.sum((r - A @ coef) ** 2) / np.sum(r**2))
+    return -float(coef[0]), explained
+
+
+def scan_mode(current: FitResult, f_lo: float, f_hi: float, *, n: int = 120, case: int = 0,
+              zeta: float = 0.02) -> tuple[float, float, float] | None:
+    """Matched scan for an unmodelled slosh mode: for trial frequencies in ``[f_lo, f_hi]``
+    simulate a unit-mass pendulum driven by the case's carriage motion and regress the
+    residual on its force together with the current fit's sensitivity columns (one
+    Gauss-Newton step of the extended model, the other parameters readjusting). The probe
+    is damped more (``zeta``) than a slosh mode, so that a trial frequency a grid step away
+    from a sharp resonance still correlates with its response.
+    Returns ``(frequency_hz, mass_kg, explained_fraction)`` of the best trial with a
+    positive mass, or ``None`` (no carriage input, or nothing explained)."""
+    import numpy as np
+
+    from analogs import LateralRig
+    from derive import derive, simulate
+
+    exp = current.problem.experiments[case]
+    dm0 = exp.derived
+    if "rig.x_ddot" not in dm0.inputs:
+        return None
+    t = np.asarray(exp.case.time, float)
+    w = current.weights[case] > 0
+    r = current.residuals[case][w]
+    g = exp.case.rig.gravity
+    offset = sum(int(c.time.size) for c in (e.case for e in current.problem.experiments[:case]))
+    J = current.sensitivity[offset:offset + t.size][w]
+    probe = derive(LateralRig() + Pendulum("q") + HingeDamper("q"))
+    best = None
+    for f in np.geomspace(f_lo, f_hi, n):
+        om = 2 * math.pi * f
+        L = g / om**2
+        sim = simulate(probe, {"rig.dry_mass": 0.0, "rig.gravity": g, "q.mass": 1.0, "q.length": L,
+                               "q.damping": 2 * zeta * L**2 * om}, t, exp.excitation,
+                       outputs=("force_x",))
+        mass, explained = _probe_regression(sim.outputs[:, 0][w], J, r)
+        if mass <= 0:
+            continue
+        if best is None or explained > best[2]:
+            best = (float(f), mass, explained)
+    return best
+
+
+def scan_rotor(current: FitResult, *, case: int = 0, n: int = 16,
+               rates: tuple[float, float] = (0.05, 20.0)) -> tuple[float, float, float] | None:
+    """Matched scan for an unmodelled rotor on a rotating rig: for trial coupling rates
+    ``c/J`` (1/s) in ``rates``, simulate a unit-inertia rotor about the tangential axis on
+    the case's rig motion and regress the (scaled, all-channel) residual on its six outputs
+    together with the current fit's sensitivity columns (one Gauss-Newton step of the
+    extended model). Returns ``(inertia, damping, explained_fraction)`` of the best trial
+    with a positive inertia, or ``None`` (the rig does not rotate, or nothing explained)."""
+    import numpy as np
+
+    from analogs import Rotor, SpinningRig
+    from derive import RK4, derive, simulate
+
+    from ..data.models import ROTOR_AXIS
+
+    problem = current.problem
+    rig = problem.model.rig
+    if not isinstance(rig, SpinningRig):
+        return None
+    exp = problem.experiments[case]
+    t = np.asarray(exp.case.time, float)
+    chans = current.channels[case]
+    scales = np.array([current.channel_scales[case][c] for c in chans])
+    w = np.tile(current.weights[case] > 0, len(chans))
+    r = (current.residuals[case] / scales).ravel(order="F")[w]
+    offset = sum(int(np.size(current.residuals[k])) for k in range(case))
+    J = current.sensitivity[offset:offset + r.size + int(np.count_nonzero(~w))][w]
+    probe = derive(Model((rig,)) + Rotor("q", axis=ROTOR_AXIS))
+    values = {k: v for k, v in problem.case_values(case, current.values).items()
+              if k.startswith("rig.")}
+    values["rig.dry_mass"] = 0.0
+    best = None
+    for rate in np.geomspace(*rates, n):
+        sim = simulate(probe, {**values, "q.inertia": 1.0, "q.damping": float(rate)}, t,
+                       integrator=RK4(), outputs=chans)
+        y = (sim.outputs / scales[None, :]).ravel(order="F")[w]
+        inertia, explained = _probe_regression(y, J, r)
+        if inertia <= 0:
+            continue
+        if best is None or explained > best[2]:
+            best = (inertia, inertia * float(rate), explained)
+    return best
+
+
+def _rotor_proposal(model: Model, measurement, current: FitResult,
+                    evidence: Evidence) -> Proposal | None:
+    from analogs import Rotor, SpinningRig
+
+    from ..data.models import ROTOR_AXIS
+
+    if not isinstance(model.rig, SpinningRig):
+        return None
+    name = next(f"r{k}" for k in range(1, 99)
+                if not any(c.name == f"r{k}" for c in model.components))
+    scan = scan_rotor(current)
+    if scan is None:
+        return None
+    inertia, damping, explained = scan
+    shares = evidence.channel_share
+    top = max(shares, key=shares.get) if shares else "torque_y"
+    tangential = f"torque_{ROTOR_AXIS}"
+
+    def plausible_rotor(r: FitResult) -> str | None:
+        for k in (f"{name}.inertia", f"{name}.damping"):
+            if not _significant(r, k, 3.0):
+                return f"`{k}` = {r.value(k):.3g} is not distinguishable from zero"
+        return None
+
+    def describe_rotor(r: FitResult) -> str:
+        torques = sum(v for k, v in shares.items() if k.startswith("torque"))
+        return (f"the residual is concentrated in the torques ({100 * torques:.0f} % of the scaled "
+                f"residual power; largest share {top} {100 * shares.get(top, 0):.0f} %, tangential "
+                f"{tangential} {100 * shares.get(tangential, 0):.0f} %), which the pendulum, tied "
+                f"to the forces, cannot produce; {100 * explained:.0f} % of the residual is the "
+                f"torque of a rotor about the tangential axis driven by the nutation -> rotational "
+                f"slosh; adding rotor {name} (inertia {r.value(f'{name}.inertia'):.3g} kg m^2, "
+                f"damping {r.value(f'{name}.damping'):.3g} N m s/rad)")
+
+    return Proposal(
+        "rotor", (name,), model + Rotor(name, axis=ROTOR_AXIS), tuple(measurement),
+        {f"{name}.inertia": inertia, f"{name}.damping": damping},
+        plausible=plausible_rotor, describe=describe_rotor)
+
+
+def propose(model: Model, measurement: tuple[MeasurementModel, ...], current: FitResult,
+            evidence: Evidence, *, gravity: float, predicted: Mapping[str, float],
+            measured_excitation: bool) -> list[Proposal]:
+    """The candidate extensions of ``model`` given the current fit and its evidence."""
+    values = dict(zip(current.names, current.values))
+    out: list[Proposal] = []
+    if len(current.channels[0] if current.channels else ()) > 1:
+        # multi-channel (spinning rig): the lateral candidates read the carriage input and
+        # the lateral force; here only what the rig's rotation can reveal
+        rotor = _rotor_proposal(model, measurement, current, evidence)
+        return [rotor] if rotor is not None else []
+    pend = _pendulums(model)
+    p1 = pend[0] if pend else None
+    m1 = values.get(f"{p1}.mass", 1.0) if p1 else 1.0
+    f1 = _freq(current, p1) if p1 else math.nan
+
+    # -- an additional slosh mode -------------------------------------------------------------
+    name = f"p{len(pend) + 1}"
+    peaks = [p for p in evidence.unexplained_peaks() if not (f1 and abs(p.frequency / f1 - 1) < 0.1)]
+    coherent = [p for p in peaks if p.coherence >= 0.3] or peaks
+    f_top = pend[-1] and _freq(current, pend[-1]) if pend else math.nan
+    cutoff = current.problem.force_cutoff_hz or 20.0
+    scan = (scan_mode(current, 1.15 * f_top, min(0.9 * cutoff, 4.0 * f_top))
+            if math.isfinite(f_top) else None)
+    f0 = m0 = None
+    if scan is not None and scan[2] > 0.05:
+        f0, m0, explained = scan
+        near = [p for p in coherent if abs(p.frequency / f0 - 1) < 0.1]
+        peak_text = (f"{100 * explained:.0f} % of the residual is the response of an oscillator at "
+                     f"{f0:.3g} Hz driven by the carriage"
+                     + (f", with a residual peak at {near[0].frequency:.3g} Hz (coherence "
+                        f"{near[0].coherence:.2f}) that is not a drive harmonic" if near else ""))
+    elif coherent:
+        top = max(coherent, key=lambda p: p.amplitude)
+        f0 = top.frequency
+        peak_text = (f"residual peak at {f0:.3g} Hz is not a drive harmonic (coherence with the "
+                     f"excitation {top.coherence:.2f})")
+    elif f"{name}.length" in predicted:
+        f0 = math.sqrt(gravity / predicted[f"{name}.length"]) / (2 * math.pi)
+        peak_text = f"the tank's mode {name[1:]} at {f0:.3g} Hz"
+    if f0 is not None:
+        L0 = gravity / (2 * math.pi * f0) ** 2
+        m0 = m0 if m0 is not None else predicted.get(f"{name}.mass", 0.04 * m1)
+        c0 = 2 * 0.01 * m0 * L0**2 * 2 * math.pi * f0
+
+        def plausible_mode(r: FitResult, name=name, prev=pend[-1] if pend else None) -> str | None:
+            m, f = r.value(f"{name}.mass"), _freq(r, name)
+            if prev and not f > 1.15 * _freq(r, prev):
+                return f"{name} at {f:.3g} Hz is not above the mode it would follow"
+            if prev and not m < r.value(f"{prev}.mass"):
+                return f"{name} mass {m:.3g} kg is not below the lower mode's"
+            if not _significant(r, f"{name}.mass", 3.0):
+                return f"{name} mass {m:.3g} kg is not distinguishable from zero"
+            return None
+
+        out.append(Proposal(
+            "slosh_mode", (name,), model + Pendulum(name) + HingeDamper(name), measurement,
+            {f"{name}.mass": m0, f"{name}.length": L0, f"{name}.damping": c0},
+            bounds={f"{name}.length": (0.8 * L0, 1.25 * L0),
+                    f"{name}.mass": (1e-6, min(m1, max(5 * predicted.get(f"{name}.mass", 0.0), 0.1 * m1)))},
+            plausible=plausible_mode,
+            describe=lambda r, name=name, txt=peak_text: (
+                f"{txt} -> an unmodelled slosh mode; adding pendulum {name} "
+                f"({r.value(f'{name}.mass'):.3g} kg, {_freq(r, name):.3g} Hz)")))
+
+    if p1 is None:
+        return out
+
+    # -- nonlinear (quadratic) damping ------------------------------------------------------
+    if not _has(model, QuadraticDamper, p1):
+        c = values.get(f"{p1}.damping", 0.0)
+
+        def plausible_quad(r: FitResult) -> str | None:
+            if not _significant(r, f"{p1}.quadratic_damping", 3.0):
+                return "the quadratic damping is not distinguishable from zero"
+            return None
+
+        spread = evidence.damping_spread
+        out.append(Proposal(
+            "nonlinear_damping", (f"{p1}:quadratic",), model + QuadraticDamper(p1), measurement,
+            {f"{p1}.quadratic_damping": max(c, 1e-6) * 0.5},
+            plausible=plausible_quad,
+            describe=lambda r: (
+                f"damping refitted segment by segment varies by a factor {spread:.2g} with the swing "
+                f"amplitude (correlation {evidence.damping_amplitude_correlation:+.2f}) -> amplitude-"
+                f"dependent (nonlinear) damping; adding a quadratic hinge damper on {p1} "
+                f"(c2 = {r.value(f'{p1}.quadratic_damping'):.3g} N m s^2/rad^2)")))
+
+    # -- diaphragm stiffness: hinge spring, length held near the prediction ----------------------
+    if not _has(model, HingeSpring, p1) and f"{p1}.length" in predicted:
+        Lp = predicted[f"{p1}.length"]
+        m = values.get(f"{p1}.mass", m1)
+        w2 = (2 * math.pi * f1) ** 2 if math.isfinite(f1) else gravity / Lp
+        k0 = max(m * Lp**2 * w2 - m * gravity * Lp, 0.05 * m * gravity * Lp)
+        ratio = evidence.frequency_ratio
+
+        def plausible_spring(r: FitResult) -> str | None:
+            if not _significant(r, f"{p1}.stiffness", 3.0):
+                return "the hinge stiffness is not distinguishable from zero"
+            return None
+
+        def describe_spring(r: FitResult) -> str:
+            k, m_, L_ = r.value(f"{p1}.stiffness"), r.value(f"{p1}.mass"), r.value(f"{p1}.length")
+            raise_ = math.sqrt(1 + k / (m_ * gravity * L_)) - 1
+            pinned = f"; `{p1}.length` was pinned at its bound" if f"{p1}.length" in evidence.pinned else ""
+            return (f"the fitted frequency is {100 * (ratio - 1):+.1f} % off the free-surface prediction"
+                    f"{pinned} -> a restoring stiffness the liquid alone lacks (diaphragm); a hinge "
+                    f"spring on {p1} with the length held near the prediction "
+                    f"(k = {k:.3g} N m/rad, +{100 * raise_:.1f} % frequency, damping ratio "
+                    f"{r.derived.get(f'{p1}.damping_ratio', (math.nan, 0))[0]:.3g})") if ratio else (
+                    f"a hinge spring on {p1} (k = {k:.3g} N m/rad)")
+
+        out.append(Proposal(
+            "diaphragm_stiffness", (f"{p1}:spring",), model + HingeSpring(p1), measurement,
+            {f"{p1}.stiffness": k0, f"{p1}.length": Lp},
+            bounds={f"{p1}.length": (0.99 * Lp, 1.01 * Lp)},
+            plausible=plausible_spring, describe=describe_spring))
+
+    # -- sensor delay (measurement model, delay profiled) -----------------------------------------
+    # only when the residual leans toward a late recording: the profile costs several fits
+    skewed = evidence.skew_delay >= 1e-3 or evidence.skew_correlation >= 0.15
+    if skewed and not any(isinstance(mm, SensorDelay) for mm in measurement):
+        def describe_delay(r: FitResult) -> str:
+            tau = next(mm.delay for mm in r.problem.measurement if isinstance(mm, SensorDelay))
+            return (f"the residual correlates with the force's rate of change (r = "
+                    f"{evidence.skew_correlation:+.2f}) -> a timing skew; a sensor delay of "
+                    f"{1e3 * tau:.1f} ms on the measured force")
+
+        def plausible_delay(r: FitResult) -> str | None:
+            tau = next(mm.delay for mm in r.problem.measurement if isinstance(mm, SensorDelay))
+            if not 1e-3 <= tau <= 0.095:
+                return f"the delay {1e3 * tau:.1f} ms is at the edge of the searched range"
+            return None
+
+        out.append(Proposal("sensor_delay", ("sensor_delay",), model, measurement, {},
+                            delay_range=(0.0, 0.1), plausible=plausible_delay,
+                            describe=describe_delay))
+
+    # -- rig friction seen by the transducer -------------------------------------------------------
+    if measured_excitation and not any(isinstance(mm, RigFriction) for mm in measurement):
+        def plausible_friction(r: FitResult) -> str | None:
+            if not (_significant(r, "rig.friction_viscous", 3.0)
+                    or _significant(r, "rig.friction_coulomb", 3.0)):
+                return "the friction coefficients are not distinguishable from zero"
+            return None
+
+        out.append(Proposal(
+            "rig_friction", ("rig_friction",), model, measurement + (RigFriction(),),
+            {"rig.friction_viscous": 0.1, "rig.friction_coulomb": 0.01},
+            plausible=plausible_friction,
+            describe=lambda r: (
+                f"a force in phase with the carriage velocity -> rig friction seen by the transducer "
+                f"(viscous {r.value('rig.friction_viscous'):.3g} N s/m, Coulomb "
+                f"{r.value('rig.friction_coulomb'):.3g} N)")))
+    return out

@@ -1,0 +1,268 @@
+"""What a fit gets wrong, as numbers: residual spectrum peaks (with their coherence with the
+excitation), drive harmonics, whiteness, timing skew, amplitude dependence of damping,
+frequency against the tank prediction, estimates pinned at bounds, and the noise floor."""
+
+from __future__ import annotations
+
+import math
+from dataclasses import dataclass, field, replace
+
+import numpy as np
+from scipy import signal
+from scipy.stats import chi2
+
+from ..data.signals import find_spectral_peaks, welch_spectrum
+from ..fitting.result import FitResult
+
+__all__ = ["Evidence", "ResidualPeak", "SegmentDamping", "collect_evidence", "noise_floor"]
+
+#: Residual peaks weaker than this fraction of the force amplitude are ignored.
+PEAK_FLOOR = 0.003
+#: Relative tolerance for calling a frequency a harmonic of the drive.
+HARMONIC_TOL = 0.03
+
+
+@dataclass(frozen=True)
+class ResidualPeak:
+    """A residual spectral peak: frequency (Hz), amplitude (N), coherence with the carriage
+    acceleration (0..1) and the drive harmonic it sits on (0 when none)."""
+
+    frequency: float
+    amplitude: float
+    coherence: float
+    harmonic: int
+
+
+@dataclass(frozen=True)
+class SegmentDamping:
+    """Damping ratio and frequency of ``p1`` refitted on one time segment, with the RMS
+    swing angle (rad) and RMS force (N) of that segment."""
+
+    start: float
+    stop: float
+    rms_angle: float
+    rms_force: float
+    damping_ratio: float
+    frequency_hz: float
+
+
+@dataclass(frozen=True)
+class Evidence:
+    """Numbers describing a fit's residual (see the module docstring)."""
+
+    rms_residual: float
+    noise_rms: float
+    drive_frequency: float | None
+    sweep: bool
+    peaks: tuple[ResidualPeak, ...]
+    harmonics: dict[int, float]
+    ljung_box_q: float
+    ljung_box_p: float
+    skew_correlation: float
+    skew_delay: float
+    frequency_ratio: float | None
+    pinned: tuple[str, ...]
+    segments: tuple[SegmentDamping, ...] = field(default=())
+    #: Multi-channel cases: each channel's share of the scaled residual power (sums to 1).
+    channel_share: dict[str, float] = field(default_factory=dict)
+
+    @property
+    def within_noise(self) -> bool:
+        """The residual is no larger than the measurement noise in the fitted band."""
+        return self.rms_residual <= 1.25 * self.noise_rms
+
+    @property
+    def damping_spread(self) -> float:
+        """Ratio of the largest to the smallest segment damping ratio (1 when flat)."""
+        z = [s.damping_ratio for s in self.segments if s.damping_ratio > 0]
+        return max(z) / min(z) if len(z) >= 2 else 1.0
+
+    @property
+    def damping_amplitude_correlation(self) -> float:
+        """Correlation between segment swing amplitude and segment damping ratio."""
+        if len(self.segments) < 3:
+            return 0.0
+        a = np.array([s.rms_angle for s in self.segments])
+        z = np.array([s.damping_ratio for s in self.segments])
+        if np.std(a) == 0 or np.std(z) == 0:
+            return 0.0
+        return float(np.corrcoef(a, z)[0, 1])
+
+    def unexplained_peaks(self) -> tuple[ResidualPeak, ...]:
+        """Peaks that are not drive harmonics, strongest first."""
+        return tuple(p for p in self.peaks if p.harmonic == 0)
+
+
+def noise_floor(time: np.ndarray, force: np.ndarray, cutoff_hz: float | None) -> float:
+    """RMS of white measurement noise inside the fitted band (N), from the raw force's PSD
+    between 1.5 and 4 times the cutoff (median, so tones do not count)."""
+    fs = 1.0 / float(np.median(np.diff(time)))
+    cut = cutoff_hz if cutoff_hz is not None else 0.2 * fs
+    spec = welch_spectrum(time, force)
+    band = (spec.frequency >= 1.5 * cut) & (spec.frequency <= min(4.0 * cut, 0.45 * fs))
+    if not np.any(band):
+        band = spec.frequency >= 0.6 * (fs / 2)
+    level = float(np.median(spec.psd[band]))
+    return math.sqrt(level * min(cut, fs / 2))
+
+
+def _drive(t: np.ndarray, acc: np.ndarray) -> tuple[float | None, bool]:
+    """Dominant excitation frequency, and whether the drive sweeps (broad spectrum)."""
+    spec = welch_spectrum(t, acc)
+    p = spec.psd
+    if not np.any(p > 0):
+        return None, False
+    main = spec.frequency[int(np.argmax(p))]
+    # share of acceleration power within +/-10 % of the dominant frequency
+    near = np.abs(spec.frequency - main) <= 0.1 * main + 2 * spec.resolution
+    sweep = float(p[near].sum() / p.sum()) < 0.7
+    peaks = find_spectral_peaks(t, acc, min_frequency=0.5 * main, max_frequency=1.5 * main, max_peaks=1)
+    return (peaks[0].frequency if peaks else float(main)), sweep
+
+
+def _ljung_box(r: np.ndarray, lags: int = 20) -> tuple[float, float]:
+    r = r - r.mean()
+    n = r.size
+    denom = float(r @ r)
+    if denom == 0:
+        return 0.0, 1.0
+    rho = np.array([float(r[:-k] @ r[k:]) / denom for k in range(1, lags + 1)])
+    q = n * (n + 2) * float(np.sum(rho**2 / (n - np.arange(1, lags + 1))))
+    return q, float(chi2.sf(q, lags))
+
+
+def collect_evidence(result: FitResult, *, case: int = 0, segments: tuple[SegmentDamping, ...] = ()
+                     ) -> Evidence:
+    """Residual evidence of ``result`` for one case (segments computed separately).
+
+    For a multi-channel case (spinning rig) the residual and noise are in channel-scale
+    units and the evidence that reads the carriage input (peak coherence, drive harmonics,
+    timing skew) is left empty; ``channel_share`` says where the residual is."""
+    if result.channels and len(result.channels[case]) > 1:
+        return _multichannel_evidence(result, case)
+    problem = result.problem
+    exp = problem.experiments[case]
+    t = np.asarray(exp.case.time, float)
+    res = result.residuals[case]
+    meas = result.measured[case]
+    w = result.weights[case] if result.weights else np.ones_like(res)
+    keep = w > 0
+    acc = _carriage_acceleration(result, case)
+    drive, sweep = _drive(t, acc) if acc is not None else (None, False)
+    amp = float(np.sqrt(2) * np.std(meas))
+    peaks = []
+    rr = np.where(keep, res, 0.0)
+    for pk in find_spectral_peaks(t, rr, min_frequency=0.3, max_frequency=problem.force_cutoff_hz or 20.0,
+                                  min_relative_height=1e-3, max_peaks=6):
+        if pk.amplitude < PEAK_FLOOR * amp:
+            continue
+        harmonic = 0
+        if drive and not sweep:
+            k = round(pk.frequency / drive)
+            if k >= 1 and abs(pk.frequency - k * drive) <= HARMONIC_TOL * k * drive:
+                harmonic = k
+        coh = 0.0
+        if acc is not None:
+            f, c = signal.coherence(acc, rr, fs=1 / float(np.median(np.diff(t))),
+                                    nperseg=min(512, t.size // 4))
+            coh = float(np.interp(pk.frequency, f, c))
+        peaks.append(ResidualPeak(pk.frequency, pk.amplitude, coh, harmonic))
+    harmonics: dict[int, float] = {}
+    if drive and not sweep:
+        for k in (2, 3):
+            fk = k * drive
+            if fk < (problem.force_cutoff_hz or 1e9):
+                design = np.column_stack([np.cos(2 * np.pi * fk * t), np.sin(2 * np.pi * fk * t)])[keep]
+                coef, *_ = np.linalg.lstsq(design, res[keep], rcond=None)
+                harmonics[k] = float(np.hypot(*coef))
+    q, pval = _ljung_box(res[keep])
+    dF = np.gradient(meas, t)
+    dk = dF[keep]
+    corr = float(np.corrcoef(res[keep], dk)[0, 1]) if np.std(dk) > 0 and np.std(res[keep]) > 0 else 0.0
+    delay = float(res[keep] @ dk / (dk @ dk)) if dk @ dk > 0 else 0.0
+    ratio = None
+    fhat = result.derived.get("p1.frequency_hz")
+    pred = exp.case.prediction
+    if fhat is not None and pred is not None:
+        f_pred = math.sqrt(exp.case.rig.gravity / pred.pendulum_length) / (2 * math.pi)
+        ratio = fhat[0] / f_pred
+    pinned = tuple(wn.split("`")[1] for wn in result.warnings if "at its bound" in wn)
+    return Evidence(
+        rms_residual=float(np.sqrt(np.mean(res[keep] ** 2))),
+        noise_rms=noise_floor(t, exp.case.force, problem.force_cutoff_hz),
+        drive_frequency=drive, sweep=sweep, peaks=tuple(peaks), harmonics=harmonics,
+        ljung_box_q=q, ljung_box_p=pval, skew_correlation=corr, skew_delay=delay,
+        frequency_ratio=ratio, pinned=pinned, segments=segments)
+
+
+def _multichannel_evidence(result: FitResult, case: int) -> Evidence:
+    problem = result.problem
+    exp = problem.experiments[case]
+    t = np.asarray(exp.case.time, float)
+    chans = result.channels[case]
+    scales = result.channel_scales[case]
+    w = result.weights[case] if result.weights else np.ones(t.size)
+    keep = w > 0
+    r = result.scaled_residuals(case)[keep]
+    power = np.sum(r**2, axis=0)
+    total = float(power.sum()) or 1.0
+    noise = [noise_floor(t, np.asarray(exp.case.channels[c], float), problem.force_cutoff_hz) / scales[c]
+             for c in chans]
+    q, pval = _ljung_box(r[:, int(np.argmax(power))])
+    pinned = tuple(wn.split("`")[1] for wn in result.warnings if "at its bound" in wn)
+    return Evidence(
+        rms_residual=float(np.sqrt(np.mean(r**2))), noise_rms=float(np.sqrt(np.mean(np.square(noise)))),
+        drive_frequency=None, sweep=False, peaks=(), harmonics={}, ljung_box_q=q,
+        ljung_box_p=pval, skew_correlation=0.0, skew_delay=0.0, frequency_ratio=None,
+        pinned=pinned, channel_share={c: float(p / total) for c, p in zip(chans, power)})
+
+
+def _carriage_acceleration(result: FitResult, case: int) -> np.ndarray | None:
+    exp = result.problem.experiments[case]
+    dm = exp.derived
+    t = np.asarray(exp.case.time, float)
+    if dm.nu and "rig.x_ddot" in dm.inputs:
+        return exp.excitation.values(t)[dm.inputs.index("rig.x_ddot")]
+    # crank drive: the rigid-body part of the simulated force, divided by the rigid mass
+    return None
+
+
+def segment_damping(result: FitResult, *, case: int = 0, n_segments: int = 4) -> tuple[SegmentDamping, ...]:
+    """Refit ``p1``'s damping and length on each of ``n_segments`` time segments (other
+    parameters held at the estimates, the segment's initial state free) and report the
+    damping ratio and frequency against the segment's swing amplitude."""
+    from ..fitting.nlp import fit
+    from ..fitting.problem import FitProblem
+
+    problem = result.problem
+    exp = problem.experiments[case]
+    names = set(result.names)
+    if exp.case.test.rig != "lateral" or not {"p1.damping", "p1.length"} <= names:
+        return ()
+    values = problem.case_values(case, result.values)
+    sim = exp.simulate(values)
+    theta = sim.state("p1.theta") if "p1.theta" in sim.state_names else None
+    c = exp.case
+    edges = np.linspace(0, c.time.size - 1, n_segments + 1).astype(int)
+    out = []
+    hold = {k: v for k, v in values.items() if k not in ("p1.damping", "p1.length")
+            and k in result.problem.experiments[case].derived.needed_parameters()}
+    for a, b in zip(edges[:-1], edges[1:]):
+        seg = replace(c, time=c.time[a:b + 1] - c.time[a], force=c.force[a:b + 1],
+                      displacement=None if c.displacement is None else c.displacement[a:b + 1])
+        try:
+            sub = FitProblem.build(seg, problem.model, estimate=["p1.damping", "p1.length"],
+                                   hold=hold, initial={"p1.damping": values["p1.damping"],
+                                                       "p1.length": values["p1.length"]},
+                                   bounds={"p1.length": (0.5 * values["p1.length"],
+                                                         2.0 * values["p1.length"])},
+                                   force_cutoff_hz=problem.force_cutoff_hz)
+            r = fit(sub, initial_state="free", progress=False, robust_start=False)
+        except (ValueError, RuntimeError):
+            continue
+        zeta = r.derived.get("p1.damping_ratio", (math.nan, 0))[0]
+        fz = r.derived.get("p1.frequency_hz", (math.nan, 0))[0]
+        swing = float(np.sqrt(np.mean(theta[a:b + 1] ** 2))) if theta is not None else math.nan
+        out.append(SegmentDamping(float(c.time[a]), float(c.time[b]), swing,
+                                  float(np.sqrt(np.mean(c.force[a:b + 1] ** 2))), float(zeta), float(fz)))
+    return tuple(out)

@@ -1,0 +1,76 @@
+"""Measurement models: what stands between the analog's force and the recorded one.
+
+A measurement model either adds a term to the simulated force (``term``, with its own
+estimated parameters) or transforms the recorded data (``measured``). They are candidates
+of the diagnosis as much as components are.
+"""
+
+from __future__ import annotations
+
+from collections.abc import Mapping
+from dataclasses import dataclass
+
+import casadi as ca
+import numpy as np
+from scipy.interpolate import CubicSpline
+
+from analogs import Param
+
+__all__ = ["MeasurementModel", "RigFriction", "SensorDelay"]
+
+
+class MeasurementModel:
+    """Base class: no term, data unchanged."""
+
+    #: Parameters by full dotted name.
+    parameters: Mapping[str, Param] = {}
+
+    def term(self, u: ca.DM, inputs: tuple[str, ...], p: Mapping[str, ca.MX]) -> ca.MX | None:
+        """Force (N) added to the simulated force at the samples, or ``None``."""
+        return None
+
+    def measured(self, t: np.ndarray, force: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
+        """Recorded force as the model should see it, and sample weights (0 = unusable)."""
+        return force, np.ones_like(force)
+
+
+@dataclass(frozen=True)
+class RigFriction(MeasurementModel):
+    """Carriage friction the transducer sees: ``c_v xd + F_c tanh(xd / v_smooth)``.
+
+    Parameters ``rig.friction_viscous`` (N s/m) and ``rig.friction_coulomb`` (N). Needs the
+    carriage velocity as a model input (measured excitation).
+    """
+
+    v_smooth: float = 1e-3  # m/s, smooths the sign of the Coulomb term
+
+    parameters = {
+        "rig.friction_viscous": Param("N s/m", 0.0, 0.0, description="viscous carriage friction"),
+        "rig.friction_coulomb": Param("N", 0.0, 0.0, description="Coulomb carriage friction"),
+    }
+
+    def term(self, u, inputs, p):
+        if "rig.x_dot" not in inputs:
+            raise ValueError("RigFriction needs the carriage velocity input `rig.x_dot` "
+                             "(a measured-displacement case)")
+        xd = u[inputs.index("rig.x_dot"), :].T
+        return p["rig.friction_viscous"] * xd + p["rig.friction_coulomb"] * ca.tanh(xd / self.v_smooth)
+
+
+@dataclass(frozen=True)
+class SensorDelay(MeasurementModel):
+    """The transducer records the force ``delay`` seconds late: ``F_rec(t) = F(t - delay)``.
+
+    The recorded force is advanced by ``delay`` (cubic spline); the last ``delay`` seconds
+    have no counterpart and get weight 0. The delay itself is estimated by profiling the
+    cost over ``delay`` (:func:`estimate.diagnosis.search.estimate_delay`).
+    """
+
+    delay: float = 0.0
+
+    def measured(self, t, force):
+        if self.delay == 0.0:
+            return force, np.ones_like(force)
+        shifted = CubicSpline(t, force)(np.clip(t + self.delay, t[0], t[-1]))
+        weights = (t + self.delay <= t[-1]).astype(float)
+        return shifted, weights

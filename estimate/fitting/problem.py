@@ -1,0 +1,268 @@
+"""The estimation problem: cases, model, which parameters are estimated (shared or per
+case), their initial values, bounds and scales. Built once, never mutated."""
+
+from __future__ import annotations
+
+import math
+from collections.abc import Mapping, Sequence
+from dataclasses import dataclass, field, replace
+
+import numpy as np
+
+from analogs import Model
+from analogs.errors import InputError, UnknownNameError
+
+from ..data.case import Case
+from ..data.experiment import Experiment, experiment
+from .initial import length_bounds, nominal_scale, predicted_values
+
+__all__ = ["FitProblem", "Estimated", "PER_CASE"]
+
+#: Rig parameters estimated separately for every case (crank phase and speed).
+PER_CASE = ("rig.omega_correction", "rig.flywheel_angle")
+
+
+@dataclass(frozen=True)
+class Estimated:
+    """One estimated parameter: ``name`` (with ``"<case id>:"`` prefix for per-case ones),
+    the model parameter it sets, its case index (``None`` when shared), unit, initial
+    value, bounds and scale."""
+
+    name: str
+    parameter: str
+    case: int | None
+    unit: str
+    initial: float
+    lower: float
+    upper: float
+    scale: float
+
+
+@dataclass(frozen=True)
+class FitProblem:
+    """Cases and a model with the parameters to estimate.
+
+    Use :meth:`build`. ``fixed[i]`` are the values case ``i`` fixes (rig values, and
+    parameters the user holds), ``estimated`` the decision parameters.
+    """
+
+    model: Model
+    experiments: tuple[Experiment, ...]
+    estimated: tuple[Estimated, ...]
+    fixed: tuple[Mapping[str, float], ...]
+    force_cutoff_hz: float | None = 10.0
+    notes: tuple[str, ...] = field(default=())
+    #: Per-case sample weights (``None``: all 1); 0 leaves a sample out of the cost.
+    weights: tuple[np.ndarray | None, ...] = field(default=(), repr=False)
+    #: Measurement models (friction, sensor delay) applied to every case.
+    measurement: tuple = field(default=())
+    #: Residual scale of a channel by output name, over the default (see :meth:`channel_scales`).
+    channel_weights: Mapping[str, float] = field(default_factory=dict)
+
+    @classmethod
+    def build(cls, cases: Case | Sequence[Case], model: Model, *,
+              estimate: Sequence[str] | None = None,
+              hold: Mapping[str, float] | None = None,
+              initial: Mapping[str, float] | None = None,
+              bounds: Mapping[str, tuple[float, float]] | None = None,
+              force_cutoff_hz: float | None = 10.0,
+              measurement: Sequence = (),
+              weights: Sequence[np.ndarray | None] | None = None,
+              channel_weights: Mapping[str, float] | None = None) -> "FitProblem":
+        """Set up the estimation of ``model`` on ``cases``.
+
+        Parameters
+        ----------
+        cases : Case or sequence of Case
+            Test cases; physical parameters are shared, crank phase and speed corrections
+            (:data:`PER_CASE`) are estimated per case.
+        model : analogs.Model
+            The analog model (its rig must match the cases' excitation).
+        estimate : sequence of str, optional
+            Parameters to estimate. Default: every parameter the equations of motion and
+            the measured force depend on, except the rig values the case file fixes.
+        hold : mapping, optional
+            Values of parameters held fixed (not estimated).
+        initial : mapping, optional
+            Initial values over the prediction (``[prediction]`` or tank modal analysis).
+        bounds : mapping, optional
+            Bounds over the defaults (physical bounds; pendulum lengths +/-20 % of the
+            prediction).
+        force_cutoff_hz : float or None, default 10
+            Zero-phase low-pass of the measured force before fitting, as the seed did.
+        measurement : sequence of MeasurementModel
+            Friction or sensor delay between the analog and the recording; their
+            parameters are estimated with the others.
+        weights : sequence of arrays, optional
+            Per-case sample weights (0 leaves samples out, e.g. held-out segments).
+        channel_weights : mapping of str to float, optional
+            Residual scale per measured channel (``"torque_y": 0.05`` in N m): each
+            channel's residual is divided by it. Default: 1 when a case measures one
+            channel (the lateral force, cost in N^2), else the RMS of the measured channel,
+            so that forces (N) and torques (N m) weigh alike. A smaller scale weighs a
+            channel more.
+
+        Examples
+        --------
+        >>> prob = FitProblem.build(case, model, channel_weights={"torque_z": 0.01})  # doctest: +SKIP
+        """
+        cases = (cases,) if isinstance(cases, Case) else tuple(cases)
+        if not cases:
+            raise InputError("no cases to fit")
+        cw = dict(channel_weights or {})
+        bad = {k: v for k, v in cw.items()
+               if isinstance(v, bool) or not isinstance(v, (int, float)) or not v > 0
+               or not math.isfinite(v)}
+        if bad:
+            raise InputError("channel_weights: expected positive finite scales (N or N m), found "
+                             + ", ".join(f"`{k}` = {v!r}" for k, v in bad.items()))
+        model = model.validate()
+        hold, initial_user, bounds_user = dict(hold or {}), dict(initial or {}), dict(bounds or {})
+        exps = tuple(experiment(c, model) for c in cases)
+        dm = exps[0].derived
+        params = {p.name: p for p in dm.parameters}
+        for mm in measurement:
+            params |= {n: _as_parameter(n, spec) for n, spec in mm.parameters.items()}
+        unknown = sorted((set(hold) | set(initial_user) | set(bounds_user) | set(estimate or ()))
+                         - set(params))
+        if unknown:
+            raise UnknownNameError(f"unknown parameter{'s' if len(unknown) > 1 else ''} "
+                           f"{', '.join(f'`{u}`' for u in unknown)}; the model's parameters are "
+                           + ", ".join(params))
+        rig_fixed = set().union(*(e.fixed for e in exps))
+        needed = dm.needed_parameters()
+        if estimate is None:
+            names = [n for n in needed if n not in rig_fixed and n not in hold]
+            names += [n for mm in measurement for n in mm.parameters if n not in hold]
+        else:
+            names = list(estimate)
+            clash = sorted(set(names) & set(hold))
+            if clash:
+                raise InputError(f"parameters both estimated and held: {', '.join(clash)}")
+        predicted = predicted_values(cases[0], model)
+        explicit = model.explicit_values()
+        notes = []
+        start: dict[str, float] = {}
+        for n in params:
+            # user's initial value > value given to a constructor > prediction > declared default
+            candidates = (initial_user.get(n), hold.get(n), explicit.get(n), predicted.get(n),
+                          params[n].default)
+            v = next((c for c in candidates if c is not None), None)
+            if v is not None:
+                start[n] = float(v)
+        missing = [n for n in names if n not in start]
+        if missing:
+            raise InputError(f"no initial value for {', '.join(missing)}: give `initial`")
+        g = cases[0].rig.gravity
+        est = []
+        for n in names:
+            p = params[n]
+            lo, hi = p.lower, p.upper
+            if n.endswith(".length") and n in predicted and n not in bounds_user:
+                lo, hi = length_bounds(predicted[n])
+                notes.append(f"`{n}` bounded to +/-20 % of the predicted {predicted[n]:.4g} m")
+            lo, hi = bounds_user.get(n, (lo, hi))
+            x0 = min(max(start[n], lo), hi)
+            scale = nominal_scale(n, x0, start, g)
+            targets = range(len(cases)) if n in PER_CASE else [None]
+            for i in targets:
+                label = n if i is None else f"{cases[i].test.id}:{n}"
+                est.append(Estimated(label, n, i, p.unit, x0, lo, hi, scale))
+        labels = [e.name for e in est]
+        if len(set(labels)) != len(labels):
+            raise InputError("case ids must be unique when per-case parameters are estimated")
+        fixed = []
+        for e in exps:
+            vals = {n: v for n, v in start.items() if n not in names}
+            vals |= {n: v for n, v in hold.items()}
+            vals |= dict(e.fixed)
+            fixed.append(vals)
+        known_channels = {c for e in exps for c in e.channels}
+        stray = sorted(set(cw) - known_channels)
+        if stray:
+            raise UnknownNameError(f"channel_weights: unknown channel{'s' if len(stray) > 1 else ''} "
+                           + ", ".join(f"`{c}`" for c in stray) + "; the cases measure "
+                           + ", ".join(sorted(known_channels)))
+        missing_ch = [e.case.test.id for e in exps if not e.channels]
+        if missing_ch:
+            raise InputError(f"cases {', '.join(missing_ch)} measure none of the model's outputs "
+                             + ", ".join(dm.measured))
+        if measurement and any(len(e.channels) > 1 for e in exps):
+            raise InputError("measurement models (friction, sensor delay) apply to the lateral "
+                             "force only; remove `measurement` for multi-channel cases")
+        w = tuple(weights) if weights is not None else tuple(None for _ in exps)
+        if len(w) != len(exps):
+            raise InputError(f"weights: expected one entry per case ({len(exps)}), got {len(w)}")
+        return cls(model, exps, tuple(est), tuple(fixed), force_cutoff_hz, tuple(notes), w,
+                   tuple(measurement), cw)
+
+    def channels(self, i: int) -> tuple[str, ...]:
+        """Output names fitted for case ``i``: the model's measured outputs the case has."""
+        return self.experiments[i].channels
+
+    def channel_scales(self, i: int) -> dict[str, float]:
+        """Residual scale of each fitted channel of case ``i`` (see ``channel_weights`` of
+        :meth:`build`): 1 for a single channel, else the RMS of the raw measured channel."""
+        names = self.channels(i)
+        have = self.experiments[i].case.channels
+        out = {}
+        for c in names:
+            if c in self.channel_weights:
+                out[c] = float(self.channel_weights[c])
+            elif len(names) == 1:
+                out[c] = 1.0
+            else:
+                out[c] = float(np.sqrt(np.mean(np.asarray(have[c], float) ** 2))) or 1.0
+        return out
+
+    @property
+    def names(self) -> tuple[str, ...]:
+        """Labels of the estimated parameters, in decision-vector order."""
+        return tuple(e.name for e in self.estimated)
+
+    def case_values(self, i: int, theta: np.ndarray, *, model_only: bool = True) -> dict[str, float]:
+        """Parameter values of case ``i`` for estimates ``theta`` (unscaled): the model's
+        (default) or also the measurement models' parameters."""
+        vals = dict(self.fixed[i])
+        for e, v in zip(self.estimated, theta):
+            if e.case is None or e.case == i:
+                vals[e.parameter] = float(v)
+        if model_only:
+            known = set(self.experiments[i].derived.parameter_names)
+            vals = {k: v for k, v in vals.items() if k in known}
+        return vals
+
+    def with_initial(self, values: Mapping[str, float]) -> "FitProblem":
+        """A copy with other initial values for some estimated parameters (by label)."""
+        est = tuple(
+            Estimated(e.name, e.parameter, e.case, e.unit,
+                      min(max(float(values.get(e.name, e.initial)), e.lower), e.upper),
+                      e.lower, e.upper, e.scale)
+            for e in self.estimated)
+        return replace(self, estimated=est)
+
+    def holding(self, label: str, value: float) -> "FitProblem":
+        """A copy in which the shared estimate ``label`` is held at ``value``."""
+        hit = [e for e in self.estimated if e.name == label]
+        if not hit or hit[0].case is not None:
+            raise UnknownNameError(f"{label!r} is not a shared estimated parameter; estimated: "
+                           + ", ".join(self.names))
+        est = tuple(e for e in self.estimated if e.name != label)
+        fixed = tuple({**f, hit[0].parameter: float(value)} for f in self.fixed)
+        return replace(self, estimated=est, fixed=fixed)
+
+    @property
+    def initial(self) -> np.ndarray:
+        return np.array([e.initial for e in self.estimated])
+
+    def check(self) -> None:
+        """Raise if an initial value is not finite."""
+        bad = [e.name for e in self.estimated if not math.isfinite(e.initial)]
+        if bad:
+            raise InputError(f"initial values are not finite: {', '.join(bad)}")
+
+
+def _as_parameter(name: str, spec):
+    from analogs import Parameter
+
+    return Parameter(name, spec.unit, spec.default, spec.lower, spec.upper, spec.description)

@@ -1,0 +1,268 @@
+"""Fit results: estimates with uncertainties, derived quantities, report and JSON."""
+
+from __future__ import annotations
+
+import math
+from dataclasses import dataclass, field
+from typing import TYPE_CHECKING, Any
+
+import casadi as ca
+import numpy as np
+
+from analogs.errors import UnknownNameError
+
+if TYPE_CHECKING:  # pragma: no cover
+    from .identifiability import Identifiability
+    from .problem import FitProblem
+
+__all__ = ["FitResult", "derived_quantities"]
+
+_AUTOCORRELATION_NOTE = (
+    "Standard errors are Gauss-Newton estimates scaled by the residual variance; force "
+    "residuals are autocorrelated, so they are optimistic. Use `profile_interval` for a "
+    "profile-likelihood interval of a chosen parameter.")
+
+
+def derived_quantities(problem: "FitProblem", theta: np.ndarray, cov: np.ndarray
+                       ) -> tuple[dict[str, tuple[float, float]], dict[str, str]]:
+    """The quantities the model's components derive (:meth:`analogs.Model.derived_quantities`,
+    e.g. ``pN.frequency_hz`` and ``pN.damping_ratio`` with the summed hinge and diaphragm
+    terms) at the estimates of case 0, with delta-method standard errors; and their units."""
+    th = ca.MX.sym("theta", theta.size)
+    vals: dict[str, Any] = dict(problem.fixed[0])
+    for j, e in enumerate(problem.estimated):
+        if e.case in (None, 0):
+            vals[e.parameter] = th[j]
+    found = problem.model.derived_quantities(vals)
+    if not found:
+        return {}, {}
+    e = ca.vertcat(*[ca.MX(v) if not isinstance(v, ca.MX) else v for v, _ in found.values()])
+    fn = ca.Function("derived", [th], [e, ca.jacobian(e, th)])
+    v, J = fn(theta)
+    v, J = np.asarray(v).ravel(), np.asarray(J)
+    se = np.sqrt(np.clip(np.einsum("ij,jk,ik->i", J, cov, J), 0, None))
+    values = {k: (float(a), float(b)) for k, a, b in zip(found, v, se)}
+    return values, {k: unit for k, (_, unit) in found.items()}
+
+
+def _json_bound(x: float) -> float | None:
+    """Infinite bounds are written as null (JSON has no infinity)."""
+    return float(x) if math.isfinite(x) else None
+
+
+@dataclass(frozen=True)
+class FitResult:
+    """The outcome of :func:`estimate.fit`.
+
+    ``values``, ``stderr`` and ``covariance`` follow ``names`` (SI units, see ``units``);
+    ``cost`` is the sum of squared force residuals (N^2) over the fitted samples (for
+    multi-channel cases: of residuals divided by their channel scales, dimensionless),
+    ``residuals`` and ``measured`` hold, per case, the residual (simulated - measured, N,
+    also on samples left out by zero weights) and the (filtered) measured force; for a
+    multi-channel case (spinning rig) both are ``samples x channels`` arrays, columns
+    named by ``channels`` (N and N m);
+    ``history`` the estimates at every IPOPT iteration.
+    """
+
+    problem: "FitProblem" = field(repr=False)
+    values: np.ndarray
+    stderr: np.ndarray
+    covariance: np.ndarray = field(repr=False)
+    cost: float
+    rms_residual: float
+    r_squared: float
+    n_samples: int
+    iterations: int
+    seconds: float
+    converged: bool
+    status: str
+    warnings: tuple[str, ...]
+    identifiability: "Identifiability" = field(repr=False)
+    derived: dict[str, tuple[float, float]]
+    history: np.ndarray = field(repr=False)
+    cost_history: np.ndarray = field(repr=False)
+    residuals: tuple[np.ndarray, ...] = field(repr=False)
+    measured: tuple[np.ndarray, ...] = field(repr=False)
+    cost_kind: str = "squared"
+    transcription: str = ""
+    #: Per-case sample weights used (0 = left out of the fit, e.g. held-out segments).
+    weights: tuple[np.ndarray, ...] = field(default=(), repr=False)
+    #: Sensitivity of the (weighted) residuals to the estimates (samples x parameters).
+    sensitivity: np.ndarray = field(default=None, repr=False)
+    #: Per case, the fitted output names (columns of ``residuals`` and ``measured`` when
+    #: there are several).
+    channels: tuple[tuple[str, ...], ...] = field(default=(), repr=False)
+    #: Per case, the residual scale of each channel (1 for the lateral force).
+    channel_scales: tuple[dict[str, float], ...] = field(default=(), repr=False)
+    #: SI unit of each derived quantity (as its component declares it).
+    derived_units: dict[str, str] = field(default_factory=dict)
+
+    def scaled_residuals(self, case: int = 0) -> np.ndarray:
+        """Residuals of ``case`` divided by their channel scales (what the cost sums):
+        1-D for one channel, ``samples x channels`` for several."""
+        r = self.residuals[case]
+        if not self.channel_scales:
+            return r
+        s = np.array([self.channel_scales[case][c] for c in self.channels[case]])
+        return r / s if r.ndim == 2 else r / s[0]
+
+    def channel(self, name: str, case: int = 0) -> tuple[np.ndarray, np.ndarray]:
+        """``(measured, residual)`` of one fitted channel of ``case`` (N or N m)."""
+        names = self.channels[case] if self.channels else ("force_x",)
+        if name not in names:
+            raise UnknownNameError(f"{name!r} was not fitted; fitted channels: {', '.join(names)}")
+        m, r = self.measured[case], self.residuals[case]
+        if m.ndim == 1:
+            return m, r
+        j = names.index(name)
+        return m[:, j], r[:, j]
+
+    @property
+    def names(self) -> tuple[str, ...]:
+        return self.problem.names
+
+    @property
+    def units(self) -> tuple[str, ...]:
+        return tuple(e.unit for e in self.problem.estimated)
+
+    def value(self, name: str) -> float:
+        """Estimate of ``name`` (a label of :attr:`names`)."""
+        return float(self.values[self._index(name)])
+
+    def _index(self, name: str) -> int:
+        try:
+            return self.names.index(name)
+        except ValueError:
+            raise UnknownNameError(f"{name!r} was not estimated; estimated: "
+                                   f"{', '.join(self.names)}") from None
+
+    @property
+    def correlation(self) -> np.ndarray:
+        d = np.sqrt(np.clip(np.diag(self.covariance), 0, None))
+        with np.errstate(invalid="ignore", divide="ignore"):
+            c = self.covariance / np.outer(d, d)
+        return np.nan_to_num(c)
+
+    def interval(self, name: str, level: float = 0.95) -> tuple[float, float]:
+        """Wald interval from the Gauss-Newton covariance (t distribution)."""
+        from scipy.stats import t as student
+
+        i = self._index(name)
+        q = student.ppf(0.5 + level / 2, max(self.n_samples - len(self.names), 1))
+        return float(self.values[i] - q * self.stderr[i]), float(self.values[i] + q * self.stderr[i])
+
+    @property
+    def case_values(self) -> list[dict[str, float]]:
+        """All model parameter values of every case at the estimates."""
+        return [self.problem.case_values(i, self.values) for i in range(len(self.problem.experiments))]
+
+    def simulated(self, case: int = 0) -> np.ndarray:
+        """Simulated force of ``case`` at the estimates (N)."""
+        return self.measured[case] + self.residuals[case]
+
+    def confounded(self) -> list[str]:
+        """Sentences naming confounded parameter groups and the combination the data fix."""
+        out = []
+        for group, why in zip(self.identifiability.groups, self.identifiability.evidence):
+            comps = {g.split(":")[-1].split(".")[0] for g in group}
+            text = (f"{' and '.join(f'`{g}`' for g in group)} are confounded: the data fix them only "
+                    f"together ({why})")
+            combos = [k for k in self.derived if k.split(".")[0] in comps and k.endswith("frequency_hz")]
+            for k in combos:
+                v, se = self.derived[k]
+                text += f"; the identifiable combination is {k} = {v:.5g} +/- {se:.2g} Hz"
+            out.append(text)
+        return out
+
+    # -- output ------------------------------------------------------------------------------
+    def to_dict(self) -> dict[str, Any]:
+        """The fixed-key JSON form written by ``slosh fit``."""
+        params: dict[str, Any] = {}
+        for name, v, se, e in zip(self.names, self.values, self.stderr, self.problem.estimated):
+            params[name] = {"value": float(v), "stderr": float(se), "unit": e.unit,
+                            "lower": _json_bound(e.lower), "upper": _json_bound(e.upper),
+                            "estimated": True}
+        units = {p.name: p.unit for p in self.problem.experiments[0].derived.parameters}
+        needed = set(self.problem.experiments[0].derived.needed_parameters())
+        for name, v in self.problem.fixed[0].items():
+            if name not in params and name in needed and v is not None and math.isfinite(v):
+                params[name] = {"value": float(v), "stderr": None, "unit": units.get(name, ""),
+                                "estimated": False}
+        model = self.problem.model
+        return {
+            "model": model.names,
+            "model_spec": getattr(model, "spec", None) or ",".join(model.names),
+            "cases": [str(e.case.path) for e in self.problem.experiments],
+            "parameters": params,
+            "covariance": {"parameters": list(self.names), "matrix": self.covariance.tolist()},
+            "correlation": self.correlation.tolist(),
+            "derived": {k: v for k, (v, _) in self.derived.items()},
+            "derived_stderr": {k: se for k, (_, se) in self.derived.items()},
+            "derived_units": dict(self.derived_units),
+            "cost": self.cost,
+            "rms_residual": self.rms_residual,
+            "r_squared": self.r_squared,
+            "iterations": self.iterations,
+            "seconds": self.seconds,
+            "converged": self.converged,
+            "status": self.status,
+            "confounded": self.confounded(),
+            "warnings": list(self.warnings),
+        }
+
+    def report(self) -> str:
+        """A text fit report: statistics, estimates with intervals, derived quantities,
+        correlations, identifiability, warnings."""
+        single = not self.channels or all(len(c) == 1 for c in self.channels)
+        lines = ["[[Fit statistics]]",
+                 f"    model              = {' + '.join(self.problem.model.names)}",
+                 f"    cases              = {', '.join(e.case.test.id for e in self.problem.experiments)}",
+                 f"    transcription      = {self.transcription}",
+                 f"    solver status      = {self.status} "
+                 f"({'converged' if self.converged else 'NOT converged'})",
+                 f"    iterations         = {self.iterations}",
+                 f"    wall time          = {self.seconds:.3f} s",
+                 f"    data points        = {self.n_samples}",
+                 f"    variables          = {len(self.names)}",
+                 f"    cost (sum r^2)     = {self.cost:.6g} {'N^2' if single else '(scaled)'}",
+                 f"    RMS residual       = {self.rms_residual:.6g} {'N' if single else '(scaled)'}",
+                 f"    R^2                = {self.r_squared:.6f}",
+                 "[[Variables]]"]
+        for name, v, se, e in zip(self.names, self.values, self.stderr, self.problem.estimated):
+            rel = f"({abs(se / v) * 100:.2f}%)" if v else ""
+            lo, hi = self.interval(name)
+            lines.append(f"    {name:28s} = {v:.6g} +/- {se:.3g} {rel:10s} {e.unit:12s} "
+                         f"95%: [{lo:.6g}, {hi:.6g}]  (init {e.initial:.4g})")
+        if self.derived:
+            lines.append("[[Derived]]")
+            for k, (v, se) in self.derived.items():
+                lines.append(f"    {k:28s} = {v:.6g} +/- {se:.3g} {self.derived_units.get(k, '')}")
+        corr = self.correlation
+        pairs = [(abs(corr[i, j]), self.names[i], self.names[j], corr[i, j])
+                 for i in range(len(self.names)) for j in range(i + 1, len(self.names))]
+        pairs = sorted((p for p in pairs if p[0] > 0.1), reverse=True)
+        if pairs:
+            lines.append("[[Correlations]] (|C| > 0.1)")
+            for _, a, b, c in pairs:
+                lines.append(f"    C({a}, {b}) = {c:+.4f}")
+        lines.append("[[Identifiability]]")
+        lines.append("    condition number of the scaled sensitivity = "
+                     f"{self.identifiability.condition_number:.3g}")
+        conf = self.confounded()
+        lines += [f"    {c}" for c in conf] or ["    every estimated parameter is determined by the data"]
+        if not single:
+            lines.append("[[Channels]] (residual scale, RMS residual / scale)")
+            for i, names in enumerate(self.channels):
+                r = self.scaled_residuals(i)
+                keep = self.weights[i] > 0 if self.weights else slice(None)
+                for j, c in enumerate(names):
+                    rms = float(np.sqrt(np.mean(r[keep, j] ** 2)))
+                    lines.append(f"    {c:12s} scale {self.channel_scales[i][c]:.4g}  "
+                                 f"RMS residual {rms:.4g}")
+        lines.append("[[Notes]]")
+        lines.append("    " + _AUTOCORRELATION_NOTE)
+        lines += [f"    {n}" for n in self.problem.notes]
+        if self.warnings:
+            lines.append("[[Warnings]]")
+            lines += [f"    {w}" for w in self.warnings]
+        return "\n".join(lines)

@@ -1,0 +1,40 @@
+"""The command line prints a user's error as one line and lets a defect show its traceback."""
+
+from pathlib import Path
+
+import pytest
+
+from analogs import InputError
+from estimate.cli import fit as cli_fit
+from estimate.cli import main
+
+EXAMPLES = Path(__file__).resolve().parents[3] / "examples"
+
+
+def test_an_input_error_is_one_line_with_status_2(capsys):
+    assert main(["fit", str(EXAMPLES / "A1.toml"), "--model", "fixed,q1"]) == 2
+    err = capsys.readouterr().err
+    assert err.startswith("slosh fit: error: --model 'fixed,q1'") and err.count("\n") == 1
+
+
+def test_an_os_error_names_the_file(capsys, tmp_path):
+    folder = tmp_path / "a_folder.json"
+    folder.mkdir()
+    # the output is a folder: refused before the fit with the path in the message
+    status = main(["fit", str(EXAMPLES / "A1.toml"), "--json", str(folder), "--overwrite"])
+    assert status == 2
+    assert str(folder) in capsys.readouterr().err
+
+
+def test_a_programming_error_is_not_disguised_as_a_user_error(monkeypatch):
+    """Before, every ValueError/KeyError became `error: ...` with status 2, hiding defects."""
+    def broken(args):
+        raise KeyError("internal table lookup")
+
+    monkeypatch.setattr(cli_fit, "run", broken)
+    with pytest.raises(KeyError, match="internal table lookup"):
+        main(["fit", str(EXAMPLES / "A1.toml")])
+
+
+def test_input_error_is_a_value_error_for_library_users():
+    assert issubclass(InputError, ValueError)

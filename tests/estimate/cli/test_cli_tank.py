@@ -1,0 +1,59 @@
+"""`slosh tank` subcommand and `TankPrediction.analog()`."""
+
+import argparse
+import json
+import math
+
+import pytest
+
+from analogs.tank import Sphere, predict
+from estimate.cli import tank as _cli_tank
+
+
+def parse(argv):
+    ap = argparse.ArgumentParser(prog="slosh")
+    _cli_tank.add_parser(ap.add_subparsers())
+    return ap.parse_args(argv)
+
+
+def test_cli_json_and_table(tmp_path, capsys):
+    out = tmp_path / "t.json"
+    args = parse(["tank", "--shape", "sphere", "--radius", "0.1016", "--fill", "0.6",
+                  "--viscosity", "0.893e-6", "--json", str(out)])
+    assert args.run(args) == 0
+    text = capsys.readouterr().out
+    assert "mode" in text and "fixed mass" in text
+    doc = json.loads(out.read_text())
+    assert doc["shape"] == "sphere" and len(doc["modes"]) == 2
+    assert doc["modes"][0]["damping_ratio"] == pytest.approx(0.00703, abs=1e-5)
+
+
+def test_cli_volume_fill_legacy_and_plot(tmp_path):
+    pytest.importorskip("matplotlib")
+    png = tmp_path / "t.png"
+    args = parse(["tank", "--radius", "0.1016", "--volume-fill", "0.648", "--method", "legacy",
+                  "--plot", str(png)])
+    assert args.run(args) == 0
+    assert png.stat().st_size > 1000
+
+
+def test_cli_bad_input_exits_2_with_message(capsys):
+    args = parse(["tank", "--shape", "cylinder", "--radius", "0.1", "--fill", "0.5"])
+    assert args.run(args) == 2
+    assert "`--length` (m) is required" in capsys.readouterr().err
+    args = parse(["tank", "--radius", "-1", "--fill", "0.5"])
+    assert args.run(args) == 2
+    assert "`radius` must be a positive number" in capsys.readouterr().err
+    with pytest.raises(SystemExit):
+        parse(["tank", "--shape", "cube", "--radius", "1", "--fill", "0.5"])
+
+
+def test_analog_model_uses_prediction():
+    p = predict(Sphere(0.1016), fill=0.6)
+    model = p.analog()
+    text = repr(model)
+    assert "FixedMass('fixed'" in text and "Pendulum('p2'" in text
+    m = p.modes[0]
+    c = 2 * m.damping_ratio * m.mass * m.length**2 * 2 * math.pi * m.frequency_hz
+    got = float(text.split("HingeDamper('p1', damping=")[1].split(")")[0])
+    assert got == pytest.approx(c, rel=1e-12)  # round-off of omega only
