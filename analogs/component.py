@@ -5,6 +5,7 @@ from __future__ import annotations
 import hashlib
 import inspect
 import sys
+import weakref
 from collections.abc import Mapping
 from typing import TYPE_CHECKING, Any, ClassVar
 
@@ -32,7 +33,19 @@ class SourceUnavailable(RuntimeError):
 def source_digest(cls: type) -> str:
     """Hash of the source of every class in ``cls``'s MRO (up to :class:`Component`) and of
     the modules defining them, so that a change to a base class or to a module-level helper
-    that ``declare`` calls changes the digest. Raises :class:`SourceUnavailable`."""
+    that ``declare`` calls changes the digest. Raises :class:`SourceUnavailable`.
+
+    Computed once per class object: the code a class runs cannot change without a new class
+    object (a reload or a new definition), which gets its own digest."""
+    if cls not in _DIGESTS:
+        _DIGESTS[cls] = _source_digest(cls)
+    return _DIGESTS[cls]
+
+
+_DIGESTS: "weakref.WeakKeyDictionary[type, str]" = weakref.WeakKeyDictionary()
+
+
+def _source_digest(cls: type) -> str:
     h = hashlib.sha256()
     for klass in cls.__mro__:
         if klass is object:

@@ -88,3 +88,30 @@ def make_spinning_case(folder: Path, name: str, rig, *, pendulum=None, rotor=Non
         time=t, channels={c: sim[c] for c in rs.CHANNELS}, prediction=prediction,
         comment="SYNTHETIC test case (tests/synthetic_cases.py)", overwrite=True)
     return case, sim
+
+
+def rig_record(folder: Path, name: str, drive, *, scale: float = 1.0, zeta: float = 0.01,
+               noise: float = 0.013, tone: float = 0.05, tone_hz: float = 25.0,
+               displacement_noise: float = 2e-5, seed: int = 0, ramp: float = 1.5,
+               ramp_start: float = 0.0):
+    """A lateral-rig record as a rig test makes it: the tank at rest, ``drive(f1)`` (a
+    ``reference_models`` excitation built from the first-mode frequency f1 in Hz) faded in
+    over ``ramp`` seconds from ``ramp_start``, force noise ``noise`` of its RMS plus a motor
+    tone (``tone`` N at scale 1, at ``tone_hz``), displacement noise (m).
+
+    ``scale`` scales the 8-inch sphere at 60 % fill geometrically (masses by scale^3,
+    lengths by scale; 4 is a full-size tank near 1 Hz). Returns ``(case, sim, truth)`` with
+    ``truth`` holding the masses (kg), length (m), f1 (Hz) and damping ratio.
+    """
+    m_p, L, m_f, dry = 1.30 * scale**3, 0.0553 * scale, 1.5 * scale**3, 1.2 * scale**3
+    p = pendulum(m_p, L, zeta)
+    f1 = ref.natural_frequency(p, G) / (2 * np.pi)
+    prediction = Prediction(1.338 * scale**3, 0.057 * scale, 1.456 * scale**3, 0.007)
+    excitation = ref.Ramped(drive(f1), ramp, ramp_start)
+    case, sim = make_case(folder, name, excitation, pendulums=[p], fixed_mass=m_f, dry_mass=dry,
+                          noise=noise, displacement_noise=displacement_noise, seed=seed,
+                          tone=ref.Tone(tone * scale**3, tone_hz) if tone else None,
+                          prediction=prediction)
+    truth = {"fixed.mass": m_f, "p1.mass": m_p, "p1.length": L, "f1": f1, "zeta": zeta,
+             "pendulum": p, "excitation": excitation}
+    return case, sim, truth

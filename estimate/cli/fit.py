@@ -22,6 +22,10 @@ def add_parser(sub: argparse._SubParsersAction) -> None:
                         "(default: fixed,p1 = fixed mass + pendulum with hinge spring and damper)")
     p.add_argument("--transcription", choices=("multiple_shooting", "collocation"),
                    default="multiple_shooting")
+    p.add_argument("--input", choices=("estimated", "filtered"), default=None,
+                   help="a measured carriage displacement is estimated with the parameters "
+                        "(default) or smoothed and differentiated beforehand (default with "
+                        "--cost abs)")
     p.add_argument("--cost", choices=("squared", "abs"), default="squared",
                    help="sum of squared residuals (default) or the seed's sum((|E|-|S|)^2)")
     p.add_argument("--json", dest="json_out", default=None, help="write the result as JSON")
@@ -44,7 +48,8 @@ def run(args: argparse.Namespace) -> int:
     cases = [load_case(c) for c in args.cases]
     spec = args.model or BASELINE
     model = model_from_spec(spec, cases[0])
-    problem = FitProblem.build(cases, model)
+    mode = args.input or ("filtered" if args.cost == "abs" else "estimated")
+    problem = FitProblem.build(cases, model, input=mode)
     tr = MultipleShooting() if args.transcription == "multiple_shooting" else Collocation()
     result = fit(problem, transcription=tr, cost=args.cost)
     if args.report or sys.stdout.isatty():

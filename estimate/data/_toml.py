@@ -20,7 +20,7 @@ from .case import (
     TestInfo,
 )
 
-__all__ = ["Checker", "read_tables"]
+__all__ = ["Checker", "read_tables", "test_kind"]
 
 
 class Checker:
@@ -123,14 +123,17 @@ def _read_test(ck: Checker, doc: Mapping[str, Any]) -> TestInfo | None:
     if spinning and "excitation" not in t:
         excitation = "spin"  # the spinning rig's motion comes from `[rig.spin]`
     note = ck.string(t, "test", "note", required=False)
+    at_rest = ck.boolean(t, "test", "starts_at_rest") if "starts_at_rest" in t else None
+    bad_rest = "starts_at_rest" in t and at_rest is None
     if data is not None and not data.strip():
         ck.add("[test] data", 'expected a CSV path, found an empty string ""')
         data = None
-    if None in (test_id, rig, data, excitation):
+    if None in (test_id, rig, data, excitation) or bad_rest:
         return None
     assert test_id is not None and rig is not None and data is not None
     assert excitation is not None
-    return TestInfo(id=test_id, rig=rig, data=data, excitation=excitation, note=note)
+    return TestInfo(id=test_id, rig=rig, data=data, excitation=excitation, note=note,
+                    starts_at_rest=at_rest)
 
 
 def _read_tank(ck: Checker, doc: Mapping[str, Any]) -> Tank | None:
@@ -248,16 +251,23 @@ def _read_prediction(ck: Checker, doc: Mapping[str, Any]) -> tuple[bool, Predict
                             damping_ratio=zeta)
 
 
+def test_kind(doc: Mapping[str, Any]) -> tuple[str | None, str | None]:
+    """``[test] excitation`` and ``rig`` when they are known values, else ``None``: what the
+    other tables and the CSV are checked against even when ``[test]`` has problems."""
+    t_table = doc.get("test")
+    if not isinstance(t_table, Mapping):
+        return None, None
+    excitation = t_table.get("excitation")
+    rig_kind = t_table.get("rig")
+    return (excitation if excitation in KNOWN_EXCITATIONS else None,
+            rig_kind if rig_kind in KNOWN_RIGS else None)
+
+
 def read_tables(ck: Checker, doc: Mapping[str, Any]):
     """All tables of ``doc``: ``(test, tank, liquid, rig, prediction_present, prediction)``;
     a table with problems is ``None`` (the problems are in ``ck``)."""
     test = _read_test(ck, doc)
-    t_table = doc.get("test")
-    excitation = None
-    if isinstance(t_table, Mapping) and t_table.get("excitation") in KNOWN_EXCITATIONS:
-        excitation = t_table["excitation"]
-    rig_kind = t_table.get("rig") if isinstance(t_table, Mapping) else None
-    rig_kind = rig_kind if rig_kind in KNOWN_RIGS else None
+    excitation, rig_kind = test_kind(doc)
     tank = _read_tank(ck, doc)
     liquid = _read_liquid(ck, doc)
     rig = _read_rig(ck, doc, excitation, rig_kind)

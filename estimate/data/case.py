@@ -8,6 +8,7 @@ CSV file with the measured samples. The format is the one of the estimation issu
     rig = "lateral"              # "lateral" now; "spinning" later
     data = "A1.csv"              # CSV path relative to this file
     excitation = "measured"      # "measured": CSV has displacement; "crank": from [rig.crank]
+    starts_at_rest = true        # optional; absent: detected from the first 0.1 s
 
     [tank]
     shape = "sphere"             # "sphere" | "cylinder"
@@ -160,6 +161,9 @@ class TestInfo:
         ``[rig.crank]``).
     note : str or None
         Free text, e.g. that the data are synthetic.
+    starts_at_rest : bool or None
+        ``[test] starts_at_rest``: whether the tank and carriage are at rest at the first
+        sample; ``None`` (absent) lets the estimation detect a quiet start.
     """
 
     __test__ = False  # not a pytest test class despite the name
@@ -169,6 +173,7 @@ class TestInfo:
     data: str
     excitation: str
     note: str | None = None
+    starts_at_rest: bool | None = None
 
 
 @dataclass(frozen=True)

@@ -21,7 +21,7 @@ from analogs.errors import InputError
 
 from .case import Case
 
-__all__ = ["BASELINE", "ROTOR_AXIS", "model_from_spec", "rig_for", "rig_values"]
+__all__ = ["BASELINE", "ROTOR_AXIS", "model_for_case", "model_from_spec", "rig_for", "rig_values"]
 
 #: Tank axis of rotor analogs on the spinning rig: ``T.y``, the tangential direction (the
 #: way the tank origin moves), about which the nutation drives a rotor (the spin-axis
@@ -52,6 +52,20 @@ def rig_for(case: Case) -> Rig:
         raise InputError(f"{case.path}: [test] rig = {case.test.rig!r} is not supported; "
                          "expected 'lateral' or 'spinning'")
     return LateralRig(excitation=case.test.excitation)
+
+
+def model_for_case(model: Model, case: Case) -> Model:
+    """``model`` on the rig ``case`` needs: a lateral model built for a measured case drives
+    a crank case through its crank (and the other way round); other rigs are kept."""
+    rig = model.rig
+    if isinstance(rig, LateralRig) and case.test.rig == "lateral" \
+            and rig.excitation != case.test.excitation:
+        shared = {"dry_mass", "gravity"}  # what both excitations of the rig have
+        swapped = LateralRig(excitation=case.test.excitation, name=rig.name,
+                             bounds={k: v for k, v in rig._bounds.items() if k in shared},
+                             **{k: v for k, v in rig._values.items() if k in shared})
+        return model.replace(swapped)
+    return model
 
 
 def rig_values(case: Case) -> dict[str, float]:

@@ -8,8 +8,8 @@ from collections.abc import Mapping
 from pathlib import Path
 
 from ._csv import read_csv
-from ._toml import Checker, read_tables
-from .case import KNOWN_EXCITATIONS, KNOWN_RIGS, Case, CaseError
+from ._toml import Checker, read_tables, test_kind
+from .case import Case, CaseError
 
 __all__ = ["load_case"]
 
@@ -59,12 +59,8 @@ def load_case(path: str | os.PathLike[str]) -> Case:
 
     ck = Checker(fname)
     test, tank, liquid, rig, pred_present, prediction = read_tables(ck, doc)
+    excitation, rig_kind = test_kind(doc)
     t_table = doc.get("test")
-    excitation = None
-    if isinstance(t_table, Mapping) and t_table.get("excitation") in KNOWN_EXCITATIONS:
-        excitation = t_table["excitation"]
-    rig_kind = t_table.get("rig") if isinstance(t_table, Mapping) else None
-    rig_kind = rig_kind if rig_kind in KNOWN_RIGS else None
 
     problems = ck.problems
     arrays = None

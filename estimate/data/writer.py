@@ -58,6 +58,8 @@ def _toml_text(test: TestInfo, tank: Tank, liquid: Liquid, rig: Rig,
     ]
     if test.note is not None:
         rows.append(("note", test.note, ""))
+    if test.starts_at_rest is not None:
+        rows.append(("starts_at_rest", test.starts_at_rest, "tank and carriage at rest at t[0]"))
     table("test", rows)
     table("tank", [("shape", tank.shape, ""), ("radius", tank.radius, "m"),
                    ("fill_fraction", tank.fill_fraction, "liquid depth / tank height"),

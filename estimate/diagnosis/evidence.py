@@ -256,7 +256,7 @@ def segment_damping(result: FitResult, *, case: int = 0, n_segments: int = 4) ->
                                                        "p1.length": values["p1.length"]},
                                    bounds={"p1.length": (0.5 * values["p1.length"],
                                                          2.0 * values["p1.length"])},
-                                   force_cutoff_hz=problem.force_cutoff_hz)
+                                   force_cutoff_hz=problem.force_cutoff_hz, input=problem.input)
             r = fit(sub, initial_state="free", progress=False, robust_start=False)
         except (ValueError, RuntimeError):
             continue

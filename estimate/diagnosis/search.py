@@ -198,7 +198,7 @@ class _Fitter:
         self.count += 1
         w = self.weights if weights == "default" else weights
         prob = FitProblem.build(self.cases, model, measurement=tuple(measurement), weights=w,
-                                bounds=bounds, force_cutoff_hz=self.cutoff)
+                                bounds=bounds, force_cutoff_hz=self.cutoff, input="filtered")
         known = set(e.name for e in prob.estimated)
         prob = prob.with_initial({k: v for k, v in initial.items() if k in known})
         # candidates that do not converge quickly are not what the data want; six-channel
@@ -238,7 +238,7 @@ def force_cutoff(cases: Sequence[Case]) -> float:
     drive frequency. A lightly damped higher mode crossed by a sweep swings far and puts odd
     harmonics into the force; filtering them out of the data but not out of the model
     biases its mass (a 3.8 Hz mode came out 17 % light at 10 Hz, within 0.2 % at 20 Hz)."""
-    from ..data.signals.derivatives import _significant_frequencies
+    from ..data.signals import significant_frequencies
 
     tops = []
     for c in cases:
@@ -246,7 +246,7 @@ def force_cutoff(cases: Sequence[Case]) -> float:
         if c.spin is not None:
             top = abs(c.spin.rate) / (2 * math.pi)
         elif c.displacement is not None:
-            top = max(_significant_frequencies(c.time, c.displacement))
+            top = max(significant_frequencies(c.time, c.displacement))
         else:
             top = c.crank.frequency if c.crank is not None else 2.5
         tops.append(min(max(10.0, 4.0 * top), 0.4 * fs))

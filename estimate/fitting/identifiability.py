@@ -20,7 +20,8 @@ GROUP_SHARE = 0.25
 
 @dataclass(frozen=True)
 class Identifiability:
-    """Singular values of the scaled sensitivity, condition number and confounded groups.
+    """Singular values of the scaled sensitivity (up to the residual scale), condition
+    number and confounded groups.
 
     ``groups`` lists tuples of parameter names that move together along a weakly
     determined direction; ``evidence`` says for each why (relative standard deviation
@@ -37,32 +38,38 @@ class Identifiability:
         return not self.groups
 
 
-def analyse(J: np.ndarray, scales: np.ndarray, names: tuple[str, ...], sigma2: float,
+def analyse(covariance: np.ndarray, scales: np.ndarray, names: tuple[str, ...],
             correlation: np.ndarray | None = None) -> Identifiability:
-    """Analyse the residual Jacobian ``J`` (residuals x parameters, unscaled units) with
-    parameter ``scales`` and residual variance ``sigma2``.
+    """Analyse the covariance of the estimates (their units squared) with parameter
+    ``scales``: its eigen-directions in relative units are the singular directions of the
+    scaled residual sensitivity, the square roots of its eigenvalues the relative standard
+    deviations along them.
 
-    A group is reported when a singular direction of the scaled sensitivity has a relative
-    standard deviation above :data:`WEAK_RELATIVE_STD`, or when two estimates correlate
-    beyond :data:`CONFOUNDED_CORRELATION`.
+    A group is reported when a direction has a relative standard deviation above
+    :data:`WEAK_RELATIVE_STD`, or when two estimates correlate beyond
+    :data:`CONFOUNDED_CORRELATION`.
     """
-    Js = J * scales[None, :]
-    if Js.size == 0:
+    if covariance.size == 0:
         return Identifiability(np.zeros(0), 1.0, (), ())
-
-    _, s, Vt = np.linalg.svd(Js, full_matrices=False)
-    smax = s[0] if s.size else 1.0
-    cond = float(smax / s[-1]) if s[-1] > 0 else float("inf")
-    groups, stds = [], []
-    for i in range(s.size):
-        std = float(np.sqrt(sigma2) / s[i]) if s[i] > 0 else float("inf")
-        if std <= WEAK_RELATIVE_STD:
+    rel = covariance / np.outer(scales, scales)
+    lam, V = np.linalg.eigh(0.5 * (rel + rel.T))
+    lam = np.clip(lam, 0.0, None)
+    stds = np.sqrt(lam)  # ascending: the best-determined direction first
+    with np.errstate(divide="ignore"):
+        # singular values of the scaled sensitivity are proportional to 1 / std
+        s = np.where(stds > 0, 1.0 / stds, np.inf)[::-1]
+    finite = s[np.isfinite(s)]
+    cond = float(finite.max() / finite.min()) if finite.size and np.all(np.isfinite(s)) \
+        else float("inf")
+    groups, evidence = [], []
+    for i in range(stds.size):
+        if stds[i] <= WEAK_RELATIVE_STD:
             continue
-        v = Vt[i] ** 2
+        v = V[:, i] ** 2
         members = tuple(names[j] for j in np.argsort(-v) if v[j] >= GROUP_SHARE)
         if len(members) > 1:
             groups.append(members)
-            stds.append(f"relative standard deviation {std:.2g} along their joint direction")
+            evidence.append(f"relative standard deviation {stds[i]:.2g} along their joint direction")
     if correlation is not None:
         for i in range(len(names)):
             for j in range(i + 1, len(names)):
@@ -70,5 +77,5 @@ def analyse(J: np.ndarray, scales: np.ndarray, names: tuple[str, ...], sigma2: f
                 if abs(correlation[i, j]) > CONFOUNDED_CORRELATION and not any(
                         set(pair) <= set(gr) for gr in groups):
                     groups.append(pair)
-                    stds.append(f"correlation {correlation[i, j]:+.4f}")
-    return Identifiability(s, cond, tuple(groups), tuple(stds))
+                    evidence.append(f"correlation {correlation[i, j]:+.4f}")
+    return Identifiability(s, cond, tuple(groups), tuple(evidence))

@@ -14,9 +14,18 @@ from analogs.errors import InputError, UnknownNameError
 
 from ..data.case import Case
 from ..data.experiment import Experiment, experiment
+from ..data.models import model_for_case
+from .carriage import CarriageInput, RecordNoise, carriage_input, record_noise
 from .initial import length_bounds, nominal_scale, predicted_values
 
-__all__ = ["FitProblem", "Estimated", "PER_CASE"]
+__all__ = ["FitProblem", "Estimated", "PER_CASE", "INPUT_MODES"]
+
+#: How a measured carriage displacement enters the fit: ``"estimated"`` (the carriage motion
+#: is estimated with the parameters, :mod:`estimate.fitting.carriage`) or ``"filtered"``
+#: (zero-phase smoothed and differentiated beforehand, then treated as exact).
+INPUT_MODES = ("estimated", "filtered")
+#: Force low-pass of the filtered-input mode [Hz] (the seed's workflow).
+FILTERED_FORCE_CUTOFF_HZ = 10.0
 
 #: Rig parameters estimated separately for every case (crank phase and speed).
 PER_CASE = ("rig.omega_correction", "rig.flywheel_angle")
@@ -50,7 +59,7 @@ class FitProblem:
     experiments: tuple[Experiment, ...]
     estimated: tuple[Estimated, ...]
     fixed: tuple[Mapping[str, float], ...]
-    force_cutoff_hz: float | None = 10.0
+    force_cutoff_hz: float | None = FILTERED_FORCE_CUTOFF_HZ
     notes: tuple[str, ...] = field(default=())
     #: Per-case sample weights (``None``: all 1); 0 leaves a sample out of the cost.
     weights: tuple[np.ndarray | None, ...] = field(default=(), repr=False)
@@ -58,6 +67,15 @@ class FitProblem:
     measurement: tuple = field(default=())
     #: Residual scale of a channel by output name, over the default (see :meth:`channel_scales`).
     channel_weights: Mapping[str, float] = field(default_factory=dict)
+    #: ``"estimated"`` or ``"filtered"`` (:data:`INPUT_MODES`).
+    input: str = "filtered"
+    #: Per case, the estimated carriage motion's spline and noise levels (``None``: the
+    #: case's excitation is used as given: filtered measurement, crank or spinning rig).
+    carriage: tuple[CarriageInput | None, ...] = field(default=(), repr=False)
+    #: Per case, the force as the estimated-input mode fits it (tones above the mechanics
+    #: removed) and its noise level, which divides the residuals (``None``: the force as
+    #: recorded, residuals divided by the default channel scales).
+    noise: tuple[RecordNoise | None, ...] = field(default=(), repr=False)
 
     @classmethod
     def build(cls, cases: Case | Sequence[Case], model: Model, *,
@@ -65,10 +83,11 @@ class FitProblem:
               hold: Mapping[str, float] | None = None,
               initial: Mapping[str, float] | None = None,
               bounds: Mapping[str, tuple[float, float]] | None = None,
-              force_cutoff_hz: float | None = 10.0,
+              force_cutoff_hz: float | None | str = "auto",
               measurement: Sequence = (),
               weights: Sequence[np.ndarray | None] | None = None,
-              channel_weights: Mapping[str, float] | None = None) -> "FitProblem":
+              channel_weights: Mapping[str, float] | None = None,
+              input: str = "estimated") -> "FitProblem":
         """Set up the estimation of ``model`` on ``cases``.
 
         Parameters
@@ -88,8 +107,10 @@ class FitProblem:
         bounds : mapping, optional
             Bounds over the defaults (physical bounds; pendulum lengths +/-20 % of the
             prediction).
-        force_cutoff_hz : float or None, default 10
-            Zero-phase low-pass of the measured force before fitting, as the seed did.
+        force_cutoff_hz : float or None, default "auto"
+            Zero-phase low-pass of the measured force before fitting [Hz]. ``"auto"``: none
+            with the estimated input (the residuals stay white, so the covariance holds),
+            10 Hz with the filtered input (the seed's workflow).
         measurement : sequence of MeasurementModel
             Friction or sensor delay between the analog and the recording; their
             parameters are estimated with the others.
@@ -101,6 +122,12 @@ class FitProblem:
             channel (the lateral force, cost in N^2), else the RMS of the measured channel,
             so that forces (N) and torques (N m) weigh alike. A smaller scale weighs a
             channel more.
+        input : {"estimated", "filtered"}, default "estimated"
+            How a measured carriage displacement enters (lateral rig): estimated with the
+            parameters, its residual weighted by the displacement noise and the force
+            residual by the force noise, both read from the spectra
+            (:mod:`estimate.fitting.carriage`); or smoothed and differentiated beforehand
+            (:func:`estimate.data.signals.displacement_derivatives`) and treated as exact.
 
         Examples
         --------
@@ -109,6 +136,11 @@ class FitProblem:
         cases = (cases,) if isinstance(cases, Case) else tuple(cases)
         if not cases:
             raise InputError("no cases to fit")
+        if input not in INPUT_MODES:
+            raise InputError(f"input must be one of {', '.join(map(repr, INPUT_MODES))}, "
+                             f"got {input!r}")
+        if force_cutoff_hz == "auto":
+            force_cutoff_hz = None if input == "estimated" else FILTERED_FORCE_CUTOFF_HZ
         cw = dict(channel_weights or {})
         bad = {k: v for k, v in cw.items()
                if isinstance(v, bool) or not isinstance(v, (int, float)) or not v > 0
@@ -118,9 +150,9 @@ class FitProblem:
                              + ", ".join(f"`{k}` = {v!r}" for k, v in bad.items()))
         model = model.validate()
         hold, initial_user, bounds_user = dict(hold or {}), dict(initial or {}), dict(bounds or {})
-        exps = tuple(experiment(c, model) for c in cases)
-        dm = exps[0].derived
-        params = {p.name: p for p in dm.parameters}
+        # each case on its own rig (a measured and a crank case share the physical parameters)
+        exps = tuple(experiment(c, model_for_case(model, c)) for c in cases)
+        params = {p.name: p for e in exps for p in e.derived.parameters}
         for mm in measurement:
             params |= {n: _as_parameter(n, spec) for n, spec in mm.parameters.items()}
         unknown = sorted((set(hold) | set(initial_user) | set(bounds_user) | set(estimate or ()))
@@ -130,7 +162,7 @@ class FitProblem:
                            f"{', '.join(f'`{u}`' for u in unknown)}; the model's parameters are "
                            + ", ".join(params))
         rig_fixed = set().union(*(e.fixed for e in exps))
-        needed = dm.needed_parameters()
+        needed = list(dict.fromkeys(n for e in exps for n in e.derived.needed_parameters()))
         if estimate is None:
             names = [n for n in needed if n not in rig_fixed and n not in hold]
             names += [n for mm in measurement for n in mm.parameters if n not in hold]
@@ -164,7 +196,8 @@ class FitProblem:
             lo, hi = bounds_user.get(n, (lo, hi))
             x0 = min(max(start[n], lo), hi)
             scale = nominal_scale(n, x0, start, g)
-            targets = range(len(cases)) if n in PER_CASE else [None]
+            targets = ([i for i, e in enumerate(exps) if n in e.derived.parameter_names]
+                       if n in PER_CASE else [None])
             for i in targets:
                 label = n if i is None else f"{cases[i].test.id}:{n}"
                 est.append(Estimated(label, n, i, p.unit, x0, lo, hi, scale))
@@ -186,34 +219,47 @@ class FitProblem:
         missing_ch = [e.case.test.id for e in exps if not e.channels]
         if missing_ch:
             raise InputError(f"cases {', '.join(missing_ch)} measure none of the model's outputs "
-                             + ", ".join(dm.measured))
+                             + ", ".join(exps[0].derived.measured))
         if measurement and any(len(e.channels) > 1 for e in exps):
             raise InputError("measurement models (friction, sensor delay) apply to the lateral "
                              "force only; remove `measurement` for multi-channel cases")
         w = tuple(weights) if weights is not None else tuple(None for _ in exps)
         if len(w) != len(exps):
             raise InputError(f"weights: expected one entry per case ({len(exps)}), got {len(w)}")
+        carriage, noise = _input_estimation(exps, input, force_cutoff_hz)
+        notes += _noise_notes(exps, carriage, noise)
         return cls(model, exps, tuple(est), tuple(fixed), force_cutoff_hz, tuple(notes), w,
-                   tuple(measurement), cw)
+                   tuple(measurement), cw, input, carriage, noise)
 
     def channels(self, i: int) -> tuple[str, ...]:
         """Output names fitted for case ``i``: the model's measured outputs the case has."""
         return self.experiments[i].channels
 
     def channel_scales(self, i: int) -> dict[str, float]:
-        """Residual scale of each fitted channel of case ``i`` (see ``channel_weights`` of
-        :meth:`build`): 1 for a single channel, else the RMS of the raw measured channel."""
-        names = self.channels(i)
-        have = self.experiments[i].case.channels
+        """Divisor of each fitted channel's residual in the cost of case ``i`` (see
+        ``channel_weights`` of :meth:`build`): the user's weight; else, with the estimated
+        input, the force noise (so force and displacement residuals are in units of their
+        noise); else :meth:`report_scale`."""
         out = {}
-        for c in names:
+        for c in self.channels(i):
             if c in self.channel_weights:
                 out[c] = float(self.channel_weights[c])
-            elif len(names) == 1:
-                out[c] = 1.0
+            elif self.noise and self.noise[i] is not None:
+                out[c] = float(self.noise[i].force_noise)
             else:
-                out[c] = float(np.sqrt(np.mean(np.asarray(have[c], float) ** 2))) or 1.0
+                out[c] = self.report_scale(i, c)
         return out
+
+    def report_scale(self, i: int, channel: str) -> float:
+        """Scale of a channel's residual in reports: 1 (N) when case ``i`` measures one
+        channel, else the RMS of the raw measured channel (forces and torques alike), or
+        the user's ``channel_weights``."""
+        if channel in self.channel_weights:
+            return float(self.channel_weights[channel])
+        if len(self.channels(i)) == 1:
+            return 1.0
+        y = np.asarray(self.experiments[i].case.channels[channel], float)
+        return float(np.sqrt(np.mean(y**2))) or 1.0
 
     @property
     def names(self) -> tuple[str, ...]:
@@ -266,3 +312,52 @@ def _as_parameter(name: str, spec):
     from analogs import Parameter
 
     return Parameter(name, spec.unit, spec.default, spec.lower, spec.upper, spec.description)
+
+
+def _input_estimation(exps: Sequence[Experiment], mode: str, cutoff: float | None
+                      ) -> tuple[tuple[CarriageInput | None, ...], tuple[RecordNoise | None, ...]]:
+    """Per case, the carriage spline (measured lateral cases) and the force noise, when the
+    input is estimated; ``None`` otherwise."""
+    if mode != "estimated":
+        return tuple(None for _ in exps), tuple(None for _ in exps)
+    if cutoff is not None:
+        raise InputError("the estimated input weighs the force by its white-noise level: "
+                         "leave `force_cutoff_hz` at its default (no force filter), or use "
+                         "input='filtered'")
+    carriage, noise = [], []
+    for e in exps:
+        case = e.case
+        if case.test.rig != "lateral" or case.force is None:
+            carriage.append(None)
+            noise.append(None)
+        elif case.test.excitation == "measured":
+            ci, rn = carriage_input(case.time, case.displacement, force=case.force,
+                                    at_rest=case.test.starts_at_rest)
+            carriage.append(ci)
+            noise.append(rn)
+        else:  # crank: the motion is a parametric model; the force's noise weighs it
+            carriage.append(None)
+            noise.append(record_noise(case.time, case.force, 2 * case.crank.frequency))
+    return tuple(carriage), tuple(noise)
+
+
+def _noise_notes(exps, carriage, noise) -> tuple[str, ...]:
+    notes = []
+    for e, ci, rn in zip(exps, carriage, noise):
+        if rn is None:
+            continue
+        cid = e.case.test.id
+        text = (f"{cid}: force noise {rn.force_noise:.3g} N"
+                + (f", displacement noise {ci.displacement_noise:.3g} m" if ci else "")
+                + f" (white levels above {rn.band_hz:.3g} Hz)")
+        if ci is not None:
+            text += (f"; carriage motion estimated (quintic spline, knots "
+                     f"{1e3 * ci.spline.spacing:.3g} ms apart"
+                     + (", at rest at the first sample)" if ci.at_rest else ")"))
+        notes.append(text)
+        for label, tones, unit in (("force", rn.tones, "N"),
+                                   ("displacement", ci.displacement_tones if ci else (), "m")):
+            if tones:
+                notes.append(f"{cid}: removed {label} tones " + ", ".join(
+                    f"{f:.4g} Hz ({a:.3g} {unit})" for f, a in tones))
+    return tuple(notes)

@@ -19,8 +19,9 @@ def profile_interval(result: FitResult, name: str, level: float = 0.95, *,
                      max_steps: int = 8) -> tuple[float, float]:
     """Profile-likelihood interval of the shared estimate ``name``.
 
-    The cost profile ``S(v) = min cost with name = v`` is compared with
-    ``S_hat + s^2 chi2_1(level)`` (``s^2`` the residual variance). Every point is a full
+    The profile ``S(v) = min objective with name = v`` (the weighted least-squares objective
+    of the fit, carriage motion included) is compared with ``S_hat + s^2 chi2_1(level)``
+    (``s^2`` the residual variance of the fit). Every point is a full
     refit, warm-started at the estimates; each side is bracketed in steps of two standard
     errors and solved with Brent's method. Unlike the Wald interval it follows the
     nonlinearity of the model; like it, it assumes independent residuals.
@@ -30,13 +31,12 @@ def profile_interval(result: FitResult, name: str, level: float = 0.95, *,
     if i is None:
         raise UnknownNameError(f"{name!r} was not estimated; estimated: {', '.join(result.names)}")
     est = problem.estimated[i]
-    dof = max(result.n_samples - len(result.names), 1)
-    threshold = result.cost + result.cost / dof * chi2.ppf(level, 1)
+    threshold = result.objective + result.residual_variance * chi2.ppf(level, 1)
     start = {n: v for n, v in zip(result.names, result.values) if n != name}
 
     def excess(v: float) -> float:
         sub = problem.holding(name, v).with_initial(start)
-        return fit(sub, progress=False).cost - threshold
+        return fit(sub, progress=False).objective - threshold
 
     v_hat = float(result.values[i])
     step = 2 * float(result.stderr[i]) or 0.01 * abs(v_hat) or est.scale * 0.01

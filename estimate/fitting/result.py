@@ -17,10 +17,7 @@ if TYPE_CHECKING:  # pragma: no cover
 
 __all__ = ["FitResult", "derived_quantities"]
 
-_AUTOCORRELATION_NOTE = (
-    "Standard errors are Gauss-Newton estimates scaled by the residual variance; force "
-    "residuals are autocorrelated, so they are optimistic. Use `profile_interval` for a "
-    "profile-likelihood interval of a chosen parameter.")
+_PROFILE_HINT = "`profile_interval` gives a profile-likelihood interval of a chosen parameter."
 
 
 def derived_quantities(problem: "FitProblem", theta: np.ndarray, cov: np.ndarray
@@ -96,6 +93,18 @@ class FitResult:
     channel_scales: tuple[dict[str, float], ...] = field(default=(), repr=False)
     #: SI unit of each derived quantity (as its component declares it).
     derived_units: dict[str, str] = field(default_factory=dict)
+    #: Per case, the estimated carriage motion ``(3, samples)``: displacement (m), velocity
+    #: (m/s), acceleration (m/s^2); ``None`` when the input was used as given.
+    carriage: tuple[np.ndarray | None, ...] = field(default=(), repr=False)
+    #: Per case, estimated minus measured carriage displacement (m), or ``None``.
+    displacement_residuals: tuple[np.ndarray | None, ...] = field(default=(), repr=False)
+    #: The weighted least-squares objective at the optimum (force and displacement residuals
+    #: in units of their scales), the residual variance ``objective / dof`` that scales the
+    #: covariance, and the degrees of freedom (observations minus estimated quantities,
+    #: carriage coefficients and free initial states included).
+    objective: float = math.nan
+    residual_variance: float = math.nan
+    dof: int = 1
 
     def scaled_residuals(self, case: int = 0) -> np.ndarray:
         """Residuals of ``case`` divided by their channel scales (what the cost sums):
@@ -148,7 +157,7 @@ class FitResult:
         from scipy.stats import t as student
 
         i = self._index(name)
-        q = student.ppf(0.5 + level / 2, max(self.n_samples - len(self.names), 1))
+        q = student.ppf(0.5 + level / 2, self.dof)
         return float(self.values[i] - q * self.stderr[i]), float(self.values[i] + q * self.stderr[i])
 
     @property
@@ -173,6 +182,24 @@ class FitResult:
                 text += f"; the identifiable combination is {k} = {v:.5g} +/- {se:.2g} Hz"
             out.append(text)
         return out
+
+    def covariance_note(self) -> str:
+        """Which covariance the standard errors come from, and what it assumes."""
+        p = self.problem
+        if p.force_cutoff_hz is not None:
+            return ("Standard errors: Gauss-Newton covariance scaled by the residual variance. "
+                    f"The force was low-passed at {p.force_cutoff_hz:g} Hz, so its residuals "
+                    "are autocorrelated and the standard errors are optimistic; the input "
+                    "was treated as exact. " + _PROFILE_HINT)
+        text = ("Standard errors: Gauss-Newton covariance of the whole NLP (states "
+                "eliminated through the dynamics")
+        if p.input == "estimated" and any(c is not None for c in p.carriage):
+            text += ("; force and displacement residuals divided by their white-noise levels, "
+                     "the carriage motion estimated and marginalised")
+        text += (f"), scaled by the residual variance {self.residual_variance:.3g} "
+                 f"({self.dof} degrees of freedom). The force is not filtered, so the "
+                 "residuals are close to independent. " + _PROFILE_HINT)
+        return text
 
     # -- output ------------------------------------------------------------------------------
     def to_dict(self) -> dict[str, Any]:
@@ -208,6 +235,12 @@ class FitResult:
             "status": self.status,
             "confounded": self.confounded(),
             "warnings": list(self.warnings),
+            "input": self.problem.input,
+            "covariance_note": self.covariance_note(),
+            "residual_variance": self.residual_variance,
+            "noise": [_noise_dict(ci, rn) for ci, rn in zip(
+                self.problem.carriage or [None] * len(self.problem.experiments),
+                self.problem.noise or [None] * len(self.problem.experiments))],
         }
 
     def report(self) -> str:
@@ -260,9 +293,23 @@ class FitResult:
                     lines.append(f"    {c:12s} scale {self.channel_scales[i][c]:.4g}  "
                                  f"RMS residual {rms:.4g}")
         lines.append("[[Notes]]")
-        lines.append("    " + _AUTOCORRELATION_NOTE)
+        lines.append("    " + self.covariance_note())
         lines += [f"    {n}" for n in self.problem.notes]
         if self.warnings:
             lines.append("[[Warnings]]")
             lines += [f"    {w}" for w in self.warnings]
         return "\n".join(lines)
+
+
+def _noise_dict(carriage, noise) -> dict[str, Any] | None:
+    """Noise levels, tones and the carriage estimate's settings of one case, for JSON."""
+    if noise is None:
+        return None
+    out: dict[str, Any] = {"force_noise_N": noise.force_noise, "band_hz": noise.band_hz,
+                           "force_tones": [{"hz": f, "amplitude_N": a} for f, a in noise.tones]}
+    if carriage is not None:
+        out |= {"displacement_noise_m": carriage.displacement_noise,
+                "displacement_tones": [{"hz": f, "amplitude_m": a}
+                                       for f, a in carriage.displacement_tones],
+                "knot_spacing_s": carriage.spline.spacing, "starts_at_rest": carriage.at_rest}
+    return out

@@ -5,6 +5,11 @@ A transcription turns one case into decision variables (states at nodes), equali
 constraints (continuity / collocation defects) and the states at the sample times, from
 which the outputs are computed. Interval functions are built once and evaluated with
 ``map``, so building the NLP does not grow with the record length.
+
+The inputs at the stage times of every interval are either data (a filtered measurement,
+evaluated from the excitation) or an expression of decision variables: an estimated
+carriage motion ``vec(U) = A c`` (:mod:`estimate.fitting.carriage`); multiple shooting then
+also returns the constraint Jacobian with respect to ``c``.
 """
 
 from __future__ import annotations
@@ -13,11 +18,14 @@ from dataclasses import dataclass
 
 import casadi as ca
 import numpy as np
+import scipy.sparse as sps
 
 from derive import DerivedModel, Excitation, rk4_step
 from derive.simulate import interval_inputs
 
-__all__ = ["Transcription", "MultipleShooting", "Collocation", "Block"]
+from ._sparse import sparse_dm
+
+__all__ = ["Transcription", "MultipleShooting", "Collocation", "Block", "InputCoefficients"]
 
 
 @dataclass(frozen=True)
@@ -27,7 +35,8 @@ class Block:
     (``nx x n``), all as functions of ``w`` and the parameter vector.
 
     ``jac_theta`` and ``jac_w``, when given, are the constraint Jacobian w.r.t. the scaled
-    parameters and ``w``, assembled from per-interval blocks (cheaper than AD of ``g``).
+    parameters and ``w``, assembled from per-interval blocks (cheaper than AD of ``g``);
+    ``jac_c`` w.r.t. the coefficients of an estimated input (see :class:`InputCoefficients`).
     """
 
     w: ca.MX
@@ -37,19 +46,34 @@ class Block:
     jac_theta: ca.MX | None = None
     jac_w: ca.MX | None = None
     g_fast: ca.MX | None = None
+    jac_c: ca.MX | None = None
+
+
+@dataclass(frozen=True)
+class InputCoefficients:
+    """Stage inputs that are a linear function of decision variables: ``vec(U) = A c``
+    (``A`` sparse, rows in the order of ``vec`` of the ``(nu m, n - 1)`` stage inputs)."""
+
+    c: ca.MX
+    A: sps.spmatrix
 
 
 class Transcription:
     """Base class of transcriptions."""
 
-    def inputs(self, exc: Excitation | None, t: np.ndarray, nu: int) -> np.ndarray:
-        """Input values needed per interval, shape ``(k * nu, n - 1)``."""
+    def fractions(self) -> np.ndarray:
+        """Times within an interval, as fractions of its length, where inputs are needed."""
         raise NotImplementedError
 
-    def block(self, dm: DerivedModel, p: ca.MX, t: np.ndarray, exc: Excitation | None,
+    def inputs(self, exc: Excitation | None, t: np.ndarray, nu: int) -> np.ndarray:
+        """Input values needed per interval, shape ``(len(fractions) * nu, n - 1)``."""
+        return interval_inputs(exc, t, self.fractions(), nu)
+
+    def block(self, dm: DerivedModel, p: ca.MX, t: np.ndarray, U: ca.DM | ca.MX,
               x_guess: np.ndarray, x0: np.ndarray | None, theta: ca.MX | None = None,
-              compiled: bool = False) -> Block:
-        """Transcribe one case; ``x_guess`` are states on ``t`` (``nx x n``); ``x0`` fixes
+              compiled: bool = False, coefficients: InputCoefficients | None = None) -> Block:
+        """Transcribe one case; ``U`` are the stage inputs (:meth:`inputs`, or an expression
+        of ``coefficients``); ``x_guess`` are states on ``t`` (``nx x n``); ``x0`` fixes
         the initial state (``None``: free). With ``theta`` (the scaled decision parameters,
         of which ``p`` is an affine function), a transcription may also return the
         constraint Jacobian blocks; ``compiled`` lets it compile per-interval functions."""
@@ -72,14 +96,13 @@ class MultipleShooting(Transcription):
 
     substeps: int = 1
 
-    def inputs(self, exc, t, nu):
-        return interval_inputs(exc, t, np.arange(2 * self.substeps + 1) / (2 * self.substeps), nu)
+    def fractions(self):
+        return np.arange(2 * self.substeps + 1) / (2 * self.substeps)
 
-    def block(self, dm, p, t, exc, x_guess, x0, theta=None, compiled=False):
+    def block(self, dm, p, t, U, x_guess, x0, theta=None, compiled=False, coefficients=None):
         n = t.size
         W, X, w0 = _states_with_fixed_start(dm.nx, n, x_guess, x0)
         step = rk4_step(dm, self.substeps)
-        U = ca.DM(self.inputs(exc, t, dm.nu))
         tk, hk = ca.DM(t[:-1]).T, ca.DM(np.diff(t)).T
         if theta is None or dm.nx == 0:
             xn = step.map(n - 1)(X[:, :-1], U, p, tk, hk)
@@ -88,21 +111,26 @@ class MultipleShooting(Transcription):
         S = ca.evalf(ca.jacobian(p, theta))
         p0 = ca.evalf(ca.substitute(p, theta, ca.DM.zeros(theta.numel())))
         fn = _step_jacobian(dm, self.substeps, theta.numel(), compiled)
-        xn, JxT, JtT = fn.map(n - 1)(X[:, :-1], U, p0, ca.vec(S), theta, tk, hk)
+        xn, JxT, JtT, JuT = fn.map(n - 1)(X[:, :-1], U, p0, ca.vec(S), theta, tk, hk)
         # g stays differentiable by CasADi (interpreted step); the possibly compiled
         # function only feeds the constraint Jacobian, which IPOPT asks for directly
         g = ca.vec(X[:, 1:] - step.map(n - 1)(X[:, :-1], U, p, tk, hk))
         jac_theta = -JtT.T  # rows of interval k stacked: (nx (n-1)) x ntheta
         jac_w = _bidiagonal(dm.nx, n, -JxT, fixed_start=x0 is not None)
+        jac_c = None
+        if coefficients is not None:
+            # d g_k / d c = -(d Phi_k / d U_k) A_k: block-diagonal stage Jacobians times A
+            nU = int(U.size1())
+            jac_c = ca.mtimes(_block_diagonal(dm.nx, nU, n - 1, -JuT), sparse_dm(coefficients.A))
         return Block(ca.vec(W), np.asarray(w0).ravel(order="F"), g, X, jac_theta, jac_w,
-                     ca.vec(X[:, 1:] - xn))
+                     ca.vec(X[:, 1:] - xn), jac_c)
 
 
 def _step_jacobian(dm: DerivedModel, substeps: int, ntheta: int, compiled: bool) -> ca.Function:
-    """``(x, U, p0, vec(S), theta, t, h) -> (x_next, (dx_next/dx)^T, (dx_next/dtheta)^T)``
-    with ``p = p0 + S theta``; blocks are transposed so that mapped outputs stack by rows.
-    Built (and compiled) once per model, substeps and number of estimates."""
-    key = ("rk4_jacobian", substeps, ntheta, compiled)
+    """``(x, U, p0, vec(S), theta, t, h) -> (x_next, (dx_next/dx)^T, (dx_next/dtheta)^T,
+    (dx_next/dU)^T)`` with ``p = p0 + S theta``; blocks are transposed so that mapped outputs
+    stack by rows. Built (and compiled) once per model, substeps and number of estimates."""
+    key = ("rk4_jacobian", substeps, ntheta, compiled, 2)
     if key not in dm._memo:
         step = rk4_step(dm, substeps)
         npar = len(dm.parameter_names)
@@ -114,7 +142,8 @@ def _step_jacobian(dm: DerivedModel, substeps: int, ntheta: int, compiled: bool)
         t, h = ca.SX.sym("t"), ca.SX.sym("h")
         xn = step(x, U, p0 + ca.mtimes(ca.reshape(Sv, npar, ntheta), th), t, h)
         fn = ca.Function("rk4_jacobian", [x, U, p0, Sv, th, t, h],
-                         [xn, ca.jacobian(xn, x).T, ca.jacobian(xn, th).T])
+                         [xn, ca.jacobian(xn, x).T, ca.jacobian(xn, th).T,
+                          ca.jacobian(xn, U).T])
         if compiled:
             from derive._compile import compiled as compile_fn
 
@@ -154,6 +183,20 @@ def _bidiagonal(nx: int, n: int, negJ: ca.MX, *, fixed_start: bool) -> ca.MX:
     return ca.MX(sp, values[nz_src.tolist()])
 
 
+def _block_diagonal(nx: int, nU: int, blocks: int, negJuT: ca.MX) -> ca.MX:
+    """``(nx blocks) x (nU blocks)`` block-diagonal matrix whose block ``k`` is the
+    transpose of columns ``k nx .. (k + 1) nx`` of ``negJuT`` (``nU x nx blocks``)."""
+    k, i, j = np.meshgrid(np.arange(blocks), np.arange(nx), np.arange(nU), indexing="ij")
+    rows = (k * nx + i).ravel()
+    cols = (k * nU + j).ravel()
+    src = ((k * nx + i) * nU + j).ravel()  # column-major index into negJuT
+    sp, mapping = ca.Sparsity.triplet(nx * blocks, nU * blocks, rows.tolist(), cols.tolist(),
+                                      True)
+    nz = np.empty(sp.nnz(), dtype=int)
+    nz[np.asarray(mapping, dtype=int)] = src
+    return ca.MX(sp, ca.vec(negJuT)[nz.tolist()])
+
+
 @dataclass(frozen=True)
 class Collocation(Transcription):
     """Direct collocation with ``degree`` Radau (default) or Legendre points per sample
@@ -185,11 +228,11 @@ class Collocation(Transcription):
                 C[j, r] = deriv(tau[r])
         return tau, C, D
 
-    def inputs(self, exc, t, nu):
+    def fractions(self):
         tau, _, _ = self._coefficients()
-        return interval_inputs(exc, t, tau[1:], nu)
+        return tau[1:]
 
-    def block(self, dm, p, t, exc, x_guess, x0, theta=None, compiled=False):
+    def block(self, dm, p, t, U, x_guess, x0, theta=None, compiled=False, coefficients=None):
         n, nx, d = t.size, dm.nx, self.degree
         tau, C, D = self._coefficients()
         W, X, w0x = _states_with_fixed_start(nx, n, x_guess, x0)
@@ -209,8 +252,7 @@ class Collocation(Transcription):
         interval = ca.Function("collocation_interval", [xk, ca.vec(xc), uk, ps, tk, h],
                                [ca.vertcat(*defects), x_end])
         XC = ca.MX.sym("XC", nx * d, n - 1)
-        U = self.inputs(exc, t, dm.nu)
-        defect, xe = interval.map(n - 1)(X[:, :-1], XC, ca.DM(U), p, ca.DM(t[:-1]).T,
+        defect, xe = interval.map(n - 1)(X[:, :-1], XC, U, p, ca.DM(t[:-1]).T,
                                          ca.DM(np.diff(t)).T)
         g = ca.vertcat(ca.vec(defect), ca.vec(X[:, 1:] - xe))
         # guess of the collocation states: linear interpolation between sample states

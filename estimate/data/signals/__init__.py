@@ -27,8 +27,9 @@ end model does not hold (e.g. a 30 Hz tone) leaks partly into the end fit; the f
 samples then carry an error of order 10% of that component's amplitude.
 """
 
-from .derivatives import displacement_derivatives
+from .derivatives import displacement_derivatives, significant_frequencies
 from .filters import lowpass
+from .noise import noise_level, remove_tones, starts_quiet
 from .spectra import (
                       DriveCheck,
                       Peak,
@@ -48,5 +49,9 @@ __all__ = [
     "dominant_frequency",
     "find_spectral_peaks",
     "lowpass",
+    "noise_level",
+    "remove_tones",
+    "significant_frequencies",
+    "starts_quiet",
     "welch_spectrum",
 ]

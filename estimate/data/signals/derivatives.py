@@ -22,11 +22,10 @@ from ._common import (
 from .filters import _extend, _pad_seconds
 from .spectra import find_spectral_peaks, welch_spectrum
 
-__all__ = ["displacement_derivatives"]
+__all__ = ["displacement_derivatives", "significant_frequencies"]
 
 
-
-def _significant_frequencies(t: NDArray[np.float64], x: NDArray[np.float64]) -> list[float]:
+def significant_frequencies(t: NDArray[np.float64], x: NDArray[np.float64]) -> list[float]:
     """Frequencies of displacement components whose *acceleration* is >= 1% of the largest.
 
     Spectral peaks cover sines and cranks; for broadband drives (sweeps, steps) the upper
@@ -135,7 +134,7 @@ def displacement_derivatives(
     fs = 1.0 / step
     if method == "butterworth":
         if cutoff_hz is None:
-            f_max = max(_significant_frequencies(t, x))
+            f_max = max(significant_frequencies(t, x))
             cutoff_hz = min(max(_AUTO_CUTOFF_MIN_HZ, _AUTO_CUTOFF_FACTOR * f_max), 0.4 * fs)
         if not 0.0 < cutoff_hz < 0.5 * fs:
             raise InputError(f"expected 0 < `cutoff_hz` < Nyquist frequency {0.5 * fs:g} Hz, "
@@ -152,7 +151,7 @@ def displacement_derivatives(
         return xs[sl].copy(), xd, xdd
     if method == "savgol":
         if window is None:
-            window = _savgol_window(_significant_frequencies(t, x), step, polyorder, t.size)
+            window = _savgol_window(significant_frequencies(t, x), step, polyorder, t.size)
         if window % 2 == 0 or window <= polyorder or window > t.size:
             raise InputError(f"expected an odd `window` > polyorder ({polyorder}) and <= "
                              f"{t.size} samples, found {window!r}")

@@ -1,0 +1,222 @@
+"""The carriage motion as part of the estimate (errors in variables).
+
+A measured displacement is noisy, and differentiating it twice to drive the model turns
+that noise, and every filter's error during the start-up ramp, into force the fit must
+explain: it moves the mass split and reports intervals that treat the input as exact. Here
+the carriage displacement is instead a quintic B-spline whose coefficients are decision
+variables of the same NLP as the parameters. Two residuals tie it to the record: the
+measured displacement (weighted by the displacement noise) and the measured force
+(weighted by the force noise), so the acceleration that drives the model is the one both
+measurements support together.
+
+The knots are uniform, spaced ``1 / (12 f_top)`` with ``f_top`` the highest significant
+frequency of the carriage motion (at least one sample, at most 50 ms): a quintic spline
+then represents the carriage acceleration to ~2e-4 of its amplitude. Both noise levels are
+estimated from the spectra above the signal band (:func:`estimate.data.signals.noise_level`);
+a record that starts quiet starts with the carriage at rest (zero velocity and
+acceleration at the first sample).
+"""
+
+from __future__ import annotations
+
+from dataclasses import dataclass, field
+
+import numpy as np
+import scipy.sparse as sps
+import scipy.sparse.linalg  # noqa: F401  (sps.linalg)
+from scipy.interpolate import BSpline
+
+from ..data.signals import noise_level, remove_tones, significant_frequencies, starts_quiet
+
+__all__ = ["CarriageSpline", "CarriageInput", "RecordNoise", "carriage_input", "record_noise"]
+
+#: Knots per period of the highest significant carriage frequency.
+KNOTS_PER_PERIOD = 12
+#: Largest knot spacing [s]: slow drives still get a spline that follows start-up transients.
+MAX_SPACING = 0.05
+#: The noise band starts this factor above the highest significant carriage frequency, and
+#: never below NOISE_BAND_MIN_HZ (the slosh modes and their harmonics live below).
+NOISE_BAND_FACTOR = 3.0
+NOISE_BAND_MIN_HZ = 12.0
+#: Noise levels are floored at this fraction of the signal's RMS: a noiseless synthetic
+#: record must not get an infinite weight.
+NOISE_FLOOR = 1e-6
+
+
+@dataclass(frozen=True)
+class CarriageSpline:
+    """A uniform B-spline of ``degree`` on ``knots`` (s); the spline is valid (full support)
+    on ``[knots[degree], knots[-degree - 1]]``, which covers the record."""
+
+    knots: np.ndarray = field(repr=False)
+    degree: int = 5
+
+    @classmethod
+    def covering(cls, t0: float, t1: float, spacing: float, degree: int = 5) -> "CarriageSpline":
+        """Uniform knots at most ``spacing`` apart whose spline is valid exactly on
+        ``[t0, t1]`` (a knot on each end, so no basis function barely touches the record)."""
+        m = max(int(np.ceil((t1 - t0) / spacing - 1e-9)), 1)
+        knots = t0 + (t1 - t0) * np.arange(-degree, m + degree + 1) / m
+        knots[degree], knots[m + degree] = t0, t1  # exact ends: no round-off outside
+        return cls(knots, degree)
+
+    @property
+    def spacing(self) -> float:
+        return float(self.knots[1] - self.knots[0])
+
+    @property
+    def n_coefficients(self) -> int:
+        return self.knots.size - self.degree - 1
+
+    def design(self, times: np.ndarray, derivative: int = 0) -> sps.csr_matrix:
+        """``(len(times), n_coefficients)`` matrix mapping coefficients to the spline's
+        ``derivative``-th time derivative at ``times`` (m, m/s, m/s^2)."""
+        k, d = self.degree, derivative
+        basis = BSpline.design_matrix(np.asarray(times, float), self.knots[d:self.knots.size - d],
+                                      k - d)
+        D = sps.identity(self.n_coefficients, format="csr")
+        for j in range(d):
+            m = self.n_coefficients - j
+            # derivative of a uniform B-spline: differences of the coefficients / spacing
+            Dj = sps.diags([-np.ones(m - 1), np.ones(m - 1)], [0, 1], shape=(m - 1, m))
+            D = (Dj / self.spacing) @ D
+        return (basis @ D).tocsr()
+
+    def inputs_matrix(self, times: np.ndarray) -> sps.csr_matrix:
+        """Matrix mapping coefficients to ``[x, xd, xdd]`` at every time, time by time
+        (rows ``3 i``, ``3 i + 1``, ``3 i + 2``), the order of a column-major ``(3, n)``."""
+        blocks = [self.design(times, d) for d in range(3)]
+        n = len(times)
+        order = np.arange(3 * n).reshape(3, n).T.ravel()  # interleave x, xd, xdd per time
+        return sps.vstack(blocks, format="csr")[order]
+
+
+
+@dataclass(frozen=True)
+class CarriageInput:
+    """What the NLP needs to estimate one case's carriage motion.
+
+    The estimated coefficients are those of ``spline`` mapped by ``basis`` (``None``: the
+    identity); a record that starts at rest uses a basis whose splines all have zero
+    velocity and acceleration at the first sample, so rest needs no constraint.
+
+    Attributes
+    ----------
+    spline : CarriageSpline
+        The representation of the displacement.
+    basis : scipy.sparse matrix or None
+        ``(spline.n_coefficients, n_coefficients)``: spline coefficients from estimated ones.
+    coefficients : numpy.ndarray
+        Start values (m): the least-squares spline through the measured displacement.
+    displacement_noise : float
+        Standard deviation of the white noise on the recorded displacement (m), estimated
+        from its spectrum above the signal band.
+    displacement : numpy.ndarray
+        The recorded displacement without tones above the signal band (m), as fitted.
+    displacement_tones : tuple of (float, float)
+        The tones removed: frequency (Hz) and amplitude (m).
+    at_rest : bool
+        The record starts quiet: the carriage velocity and acceleration are 0 at ``t[0]``.
+    """
+
+    spline: CarriageSpline
+    basis: sps.spmatrix | None = field(repr=False)
+    coefficients: np.ndarray = field(repr=False)
+    displacement_noise: float
+    displacement: np.ndarray = field(repr=False)
+    displacement_tones: tuple[tuple[float, float], ...]
+    at_rest: bool
+
+    @property
+    def n_coefficients(self) -> int:
+        return self.spline.n_coefficients if self.basis is None else self.basis.shape[1]
+
+    def design(self, times: np.ndarray, derivative: int = 0) -> sps.csr_matrix:
+        """Estimated coefficients to the ``derivative``-th derivative at ``times``."""
+        B = self.spline.design(times, derivative)
+        return B if self.basis is None else (B @ self.basis).tocsr()
+
+    def inputs_matrix(self, times: np.ndarray) -> sps.csr_matrix:
+        """Estimated coefficients to ``[x, xd, xdd]`` time by time (see
+        :meth:`CarriageSpline.inputs_matrix`)."""
+        A = self.spline.inputs_matrix(times)
+        return A if self.basis is None else (A @ self.basis).tocsr()
+
+    def values(self, coefficients: np.ndarray, times: np.ndarray) -> np.ndarray:
+        """``(3, len(times))``: displacement (m), velocity (m/s), acceleration (m/s^2)."""
+        return np.vstack([self.design(times, d) @ coefficients for d in range(3)])
+
+
+def _rest_basis(spline: CarriageSpline, t0: float) -> sps.csr_matrix:
+    """Basis of the splines with zero velocity and acceleration at ``t0``: the first two
+    coefficients follow from the others, ``c01 = -C01^-1 C_rest c_rest``."""
+    C = sps.vstack([spline.design([t0], 1), spline.design([t0], 2)]).toarray()
+    n = spline.n_coefficients
+    head = -np.linalg.solve(C[:, :2], C[:, 2:])
+    return sps.vstack([sps.csr_matrix(head), sps.identity(n - 2, format="csr")]).tocsr()
+
+
+@dataclass(frozen=True)
+class RecordNoise:
+    """The force of a record as the estimated-input fit uses it.
+
+    Attributes
+    ----------
+    force_noise : float
+        Standard deviation of the white noise on the recorded force (N), from its spectrum
+        above ``band_hz``; the force residuals are divided by it.
+    force : numpy.ndarray
+        The recorded force without the tones above ``band_hz`` (N).
+    tones : tuple of (float, float)
+        The tones removed: frequency (Hz) and amplitude (N).
+    band_hz : float
+        Lower edge of the band above the mechanics (Hz) where noise and tones were read.
+    """
+
+    force_noise: float
+    force: np.ndarray = field(repr=False)
+    tones: tuple[tuple[float, float], ...]
+    band_hz: float
+
+
+def record_noise(time: np.ndarray, force: np.ndarray, top_frequency: float) -> RecordNoise:
+    """Noise level and tones of a recorded force (N) whose mechanics reach up to
+    ``top_frequency`` (Hz): both read above ``max(3 top_frequency, 12 Hz)``."""
+    band = max(NOISE_BAND_FACTOR * top_frequency, NOISE_BAND_MIN_HZ)
+    F = np.asarray(force, float)
+    clean, tones = remove_tones(time, F, above_hz=band)
+    level = max(noise_level(time, clean, above_hz=band),
+                NOISE_FLOOR * float(np.sqrt(np.mean(F**2))))
+    return RecordNoise(level, clean, tones, band)
+
+
+def carriage_input(time: np.ndarray, displacement: np.ndarray, *,
+                   at_rest: bool | None = None,
+                   force: np.ndarray | None = None) -> tuple[CarriageInput, RecordNoise]:
+    """Spline, start values and noise levels for estimating the carriage motion of a record
+    (``time`` s, ``displacement`` m, ``force`` N), and the force's noise. ``at_rest=None``
+    detects a quiet start (:func:`estimate.data.signals.starts_quiet` on both channels)."""
+    t = np.asarray(time, float)
+    x = np.asarray(displacement, float)
+    dt = float(np.median(np.diff(t)))
+    f_top = max(significant_frequencies(t, x))
+    spacing = min(max(1.0 / (KNOTS_PER_PERIOD * f_top), dt), MAX_SPACING)
+    noise = record_noise(t, force, f_top)
+    x_clean, x_tones = remove_tones(t, x, above_hz=noise.band_hz)
+    sx = max(noise_level(t, x_clean, above_hz=noise.band_hz), NOISE_FLOOR * float(np.std(x)))
+    if at_rest is None:
+        at_rest = starts_quiet(t, x_clean, sx) and starts_quiet(t, noise.force, noise.force_noise)
+    spline = CarriageSpline.covering(float(t[0]), float(t[-1]), spacing)
+    basis = _rest_basis(spline, float(t[0])) if at_rest else None
+    B = spline.design(t) if basis is None else (spline.design(t) @ basis).tocsr()
+    ci = CarriageInput(spline, basis, _least_squares(B, x_clean), sx, x_clean, x_tones,
+                       bool(at_rest))
+    return ci, noise
+
+
+def _least_squares(B: sps.spmatrix, x: np.ndarray) -> np.ndarray:
+    """Coefficients of the spline (design ``B``) through the samples ``x``."""
+    A = (B.T @ B).tocsc()
+    # a ridge far below the data's weight keeps every coefficient defined
+    A = A + 1e-10 * A.diagonal().mean() * sps.identity(A.shape[0], format="csc")
+    return np.asarray(sps.linalg.spsolve(A, B.T @ x)).ravel()

@@ -1,0 +1,180 @@
+"""One test case as terms of the estimation NLP: its transcribed dynamics, the residuals of
+its measured channels (and of the carriage displacement when the input is estimated), and
+the data as fitted."""
+
+from __future__ import annotations
+
+import math
+from collections.abc import Mapping
+from dataclasses import dataclass
+
+import casadi as ca
+import numpy as np
+
+from analogs.errors import InputError
+from derive import OUTPUT_NAMES, RK4, Sampled, simulate
+
+from ..data.signals import lowpass
+from ._sparse import sparse_dm
+from .problem import FitProblem
+from .transcription import Block, InputCoefficients, Transcription
+
+__all__ = ["CaseTerms", "case_terms"]
+
+
+def _measured_output(dm, channels: tuple[str, ...]) -> ca.Function:
+    x = ca.SX.sym("x", dm.nx)
+    u = ca.SX.sym("u", dm.nu)
+    p = ca.SX.sym("p", len(dm.parameter_names))
+    t = ca.SX.sym("t")
+    out = dm.outputs(x, u, p, t)
+    y = ca.vertcat(*[out[OUTPUT_NAMES.index(c)] for c in channels])
+    return ca.Function("measured", [x, u, p, t], [y])
+
+
+def _parameter_column(dm, values: Mapping[str, float], theta: ca.MX, problem: FitProblem,
+                      case: int) -> ca.MX:
+    """The model's parameter vector for one case as an MX of the scaled decision vector."""
+    entries = []
+    for name in dm.parameter_names:
+        hit = None
+        for j, e in enumerate(problem.estimated):
+            if e.parameter == name and (e.case is None or e.case == case):
+                hit = theta[j] * e.scale
+        if hit is None:
+            v = values.get(name)
+            hit = ca.MX(0.0 if v is None or not math.isfinite(v) else float(v))
+        entries.append(hit)
+    return ca.vertcat(*entries)
+
+
+def _measured_force(problem: FitProblem, i: int) -> tuple[np.ndarray, np.ndarray]:
+    """The recorded channels as fitted (filtered, measurement models applied) and weights.
+
+    One channel (the lateral force): a 1-D array; several: ``samples x channels`` in the
+    order of :meth:`FitProblem.channels`."""
+    exp = problem.experiments[i]
+    case = exp.case
+    names = problem.channels(i)
+    have = case.channels
+    cols = []
+    w = (np.ones(case.time.size) if problem.weights[i] is None
+         else np.asarray(problem.weights[i], float))
+    noise = problem.noise[i] if problem.noise else None
+    for name in names:
+        F = np.asarray(have[name] if noise is None else noise.force, float)
+        if problem.force_cutoff_hz is not None:
+            F = lowpass(case.time, F, cutoff_hz=problem.force_cutoff_hz)
+        for mm in problem.measurement:
+            F, wm = mm.measured(case.time, F)
+            w = w * wm
+        cols.append(F)
+    return (cols[0] if len(cols) == 1 else np.column_stack(cols)), w
+
+
+@dataclass(frozen=True)
+class CaseTerms:
+    """One case in the NLP.
+
+    ``block`` is its transcription; ``coef`` and ``coef0`` the coefficients of an estimated
+    carriage motion (empty otherwise) with their start values. ``r`` is
+    the cost residual and ``e`` the residual whose squares the covariance uses (``= r`` for
+    the squared cost): force residuals divided by their scale, then displacement residuals
+    divided by the displacement noise. ``raw`` is ``Y - F`` (N, N m; channel-major) and
+    ``report`` the force residual in the units of the fit report (weighted, scaled)."""
+
+    block: Block
+    coef: ca.MX
+    coef0: np.ndarray
+    r: ca.MX
+    e: ca.MX
+    raw: ca.MX
+    report: ca.MX
+    measured: np.ndarray
+    weights: np.ndarray
+    scaled_measured: np.ndarray
+    free_initial_state: bool
+    carriage: ca.MX | None
+    displacement_residual: ca.MX | None
+
+
+def case_terms(problem: FitProblem, i: int, theta_s: ca.MX, transcription: Transcription,
+                cost: str, initial_state: str, blocks_ok: bool, compile_: bool) -> CaseTerms:
+    exp = problem.experiments[i]
+    dm, case = exp.derived, exp.case
+    t = np.asarray(case.time, float)
+    n = t.size
+    p_i = _parameter_column(dm, problem.fixed[i], theta_s, problem, i)
+    carriage = problem.carriage[i] if problem.carriage else None
+    coefficients = None
+    excitation = exp.excitation
+    if carriage is not None:
+        if dm.inputs != _CARRIAGE_INPUTS:
+            raise InputError(f"an estimated carriage motion drives the inputs "
+                             f"{', '.join(_CARRIAGE_INPUTS)}; the model takes {', '.join(dm.inputs)}")
+        c = ca.MX.sym(f"carriage{i}", carriage.n_coefficients)
+        fr = transcription.fractions()
+        stage_times = (t[:-1, None] + np.diff(t)[:, None] * fr[None, :]).ravel()
+        A_stage = carriage.inputs_matrix(stage_times)
+        U = ca.reshape(ca.mtimes(sparse_dm(A_stage), c), dm.nu * fr.size, n - 1)
+        A_grid = carriage.inputs_matrix(t)
+        Ug = ca.reshape(ca.mtimes(sparse_dm(A_grid), c), dm.nu, n)
+        coefficients = InputCoefficients(c, A_stage)
+        excitation = Sampled(t, carriage.values(carriage.coefficients, t))
+        coef, coef0 = c, carriage.coefficients
+    else:
+        U = ca.DM(transcription.inputs(excitation, t, dm.nu))
+        Ug = ca.DM(excitation.values(t) if dm.nu else np.zeros((0, n)))
+        coef, coef0 = ca.MX(0, 1), np.zeros(0)
+    if dm.nx:
+        values0 = problem.case_values(i, problem.initial)
+        guess = simulate(dm, values0, t, excitation, integrator=RK4()).states.T
+    else:
+        guess = np.zeros((0, n))
+    x0 = np.zeros(dm.nx) if initial_state == "rest" else None
+    block = transcription.block(dm, p_i, t, U, guess, x0, theta=theta_s if blocks_ok else None,
+                                compiled=compile_, coefficients=coefficients)
+    chans = problem.channels(i)
+    Y = _measured_output(dm, chans).map(n)(block.X, Ug, p_i, ca.DM(t).T).T
+    mvals = {e.parameter: theta_s[j] * e.scale for j, e in enumerate(problem.estimated)
+             if e.case in (None, i)}
+    for mm in problem.measurement:
+        extra = mm.term(Ug, dm.inputs, mvals)
+        if extra is not None:
+            Y = Y + extra
+    F, wts = _measured_force(problem, i)
+    scale = problem.channel_scales(i)
+    s = np.array([scale[ch] for ch in chans])
+    F2 = F.reshape(n, len(chans), order="F")
+    # channel-major: each channel divided by its scale, so N and N m are comparable
+    Yv = ca.vec(Y / ca.repmat(ca.DM(s).T, n, 1))
+    Fv = (F2 / s[None, :]).ravel(order="F")
+    wv = np.tile(wts, len(chans))
+    raw = ca.vec(Y) - ca.DM(F2.ravel(order="F"))
+    e = Yv - ca.DM(Fv)
+    if cost == "squared":
+        r = e
+    else:
+        eps = 1e-3 * float(np.std(Fv))
+        r = ca.sqrt(Yv**2 + eps**2) - ca.DM(np.abs(Fv))
+    if np.any(wv != 1.0):
+        e = e * ca.DM(wv)
+        r = e if cost == "squared" else r * ca.DM(wv)
+    # the fit report keeps its units: N for a lateral force, channel RMS for several channels
+    report_scale = np.array([problem.report_scale(i, ch) for ch in chans])
+    report = raw / ca.DM(np.repeat(report_scale, n)) * ca.DM(wv)
+    scaled_measured = (F2 / report_scale[None, :]).ravel(order="F")
+    x_resid = None
+    if carriage is not None:
+        B0 = sparse_dm(carriage.design(t))
+        x_resid = ca.mtimes(B0, coef) - ca.DM(carriage.displacement)
+        ex = x_resid / carriage.displacement_noise
+        e = ca.vertcat(e, ex)
+        r = e if cost == "squared" else ca.vertcat(r, ex)
+    return CaseTerms(block, coef, coef0, r, e, raw, report, F, wts,
+                      scaled_measured, x0 is None,
+                      None if carriage is None else ca.reshape(Ug, dm.nu, n), x_resid)
+
+
+#: The inputs an estimated carriage motion supplies, in the order of its spline's rows.
+_CARRIAGE_INPUTS = ("rig.x", "rig.x_dot", "rig.x_ddot")
