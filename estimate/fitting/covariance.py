@@ -68,19 +68,15 @@ def uncertainty(jac_residuals: sps.spmatrix, jac_constraints: sps.spmatrix,
     nw, ng = Je.shape[1], Jg.shape[0]
     k = nw - ng  # estimated quantities: variables the constraints leave free
     sigma2 = float(residuals @ residuals) / max(n_observations - k, 1)
-    H = (Je.T @ Je).tocsc()
+    S = parameter_information(Je, Jg, ntheta)
+    # a prior of relative standard deviation 1e3 on every (scaled) parameter: nothing for
+    # what the data determine, a huge finite variance for a direction they do not
+    lam, V = np.linalg.eigh(0.5 * (S + S.T))
     warnings = []
-    X = _kkt_block(H, Jg, ntheta)
-    if X is None:
-        # directions the data do not determine: a ridge far below the information makes
-        # the system solvable and gives them huge (not meaningless finite) variances
-        ridge = 1e-10 * float(H.diagonal().max() or 1.0)
-        X = _kkt_block((H + ridge * sps.identity(nw, format="csc")).tocsc(), Jg, ntheta)
+    if lam.min() <= _PRIOR_INFORMATION * max(lam.max(), 1.0) * 1e-3:
         warnings.append("the residual sensitivity is singular: the data do not determine some "
                         "directions of the parameters (see the identifiability check)")
-        if X is None:
-            X = np.full((ntheta, ntheta), np.inf)
-    X = 0.5 * (X + X.T)
+    X = (V / np.maximum(lam, _PRIOR_INFORMATION)) @ V.T
     cov = sigma2 * X * np.outer(scales, scales)
     d = np.sqrt(np.clip(np.diag(cov), 0, None))
     with np.errstate(invalid="ignore", divide="ignore"):
@@ -89,40 +85,58 @@ def uncertainty(jac_residuals: sps.spmatrix, jac_constraints: sps.spmatrix,
     return Uncertainty(cov, d, corr, sigma2, ident, tuple(warnings))
 
 
-def _kkt_block(H: sps.csc_matrix, Jg: sps.csc_matrix, ntheta: int) -> np.ndarray | None:
-    """The first ``ntheta`` rows and columns of ``[[H, Jg^T], [Jg, 0]]^-1``, or ``None``
-    when the matrix is singular.
+#: Information floor of each scaled parameter's direction (relative variance 1e6 at most).
+_PRIOR_INFORMATION = 1e-6
+#: Refinement steps allowed before the pivoted LU takes over.
+_REFINEMENTS = 8
 
-    The matrix is made quasi-definite by ``+delta I`` and ``-eps I`` diagonal blocks far
-    below its entries (1e-15 relative), which CasADi's sparse LDL^T factorises without
-    pivoting; one step of iterative refinement on the unregularised matrix removes their
-    effect, and a residual that stays large falls back to SuperLU's pivoted LU."""
+
+def parameter_information(Je: sps.spmatrix, Jg: sps.spmatrix, ntheta: int) -> np.ndarray:
+    """Gauss-Newton information of the first ``ntheta`` variables, every other variable
+    eliminated through the constraints or marginalised: the Schur complement
+    ``H_tt - B^T K0^-1 B`` of the KKT matrix ``[[H, Jg^T], [Jg, 0]]`` (``H = Je^T Je``) onto
+    them, with ``K0`` the KKT matrix of the other variables (parameters held)."""
+    Je = sps.csc_matrix(Je)
+    Jg = sps.csc_matrix(Jg)
+    H = (Je.T @ Je).tocsc()
+    p = ntheta
+    Htt = H[:p, :p].toarray()
+    if H.shape[0] == p and Jg.shape[0] == 0:
+        return Htt  # nothing but parameters (a rigid tank: no states, no constraints)
+    Hrr, Hrt = H[p:, p:], H[p:, :p]
+    Gr, Gt = Jg[:, p:], Jg[:, :p]
+    K0 = sps.bmat([[Hrr, Gr.T], [Gr, None]], format="csc") if Jg.shape[0] else Hrr
+    B = sps.vstack([Hrt, Gt]).toarray() if Jg.shape[0] else Hrt.toarray()
+    Y = _solve(K0, B, n_primal=Hrr.shape[0])
+    return Htt - B.T @ Y
+
+
+def _solve(K: sps.csc_matrix, B: np.ndarray, n_primal: int) -> np.ndarray:
+    """``K^-1 B`` for a KKT matrix ``K`` (``n_primal`` primal rows first).
+
+    ``K`` is made quasi-definite by ``+delta I`` and ``-eps I`` diagonal blocks far below its
+    entries (1e-15 relative), which CasADi's sparse LDL^T factorises without pivoting;
+    iterative refinement on ``K`` itself removes their effect. With the parameters held, the
+    states and nuisance variables are well determined, so refinement converges; if it does
+    not, SuperLU's pivoted LU solves the system."""
     import casadi as ca
 
     from ._sparse import sparse_dm
 
-    nw, ng = H.shape[0], Jg.shape[0]
-    kkt = sps.bmat([[H, Jg.T], [Jg, None]], format="csc") if ng else H
-    rhs = np.zeros((nw + ng, ntheta))
-    rhs[np.arange(ntheta), np.arange(ntheta)] = 1.0
-    scale = float(abs(H).max()) or 1.0
-    reg = sps.diags(np.concatenate([np.full(nw, 1e-15 * scale), np.full(ng, -1e-15)]))
-    K = sparse_dm((kkt + reg).tocsc())
-    X = None
+    n = K.shape[0]
+    scale = float(abs(K).max()) or 1.0
+    reg = sps.diags(np.r_[np.full(n_primal, 1e-15 * scale), np.full(n - n_primal, -1e-15)])
+    Kr = sparse_dm((K + reg).tocsc())
     try:
-        solver = ca.Linsol("kkt", "ldl", K.sparsity())
-        X = np.asarray(solver.solve(K, ca.DM(rhs)))
-        X = X + np.asarray(solver.solve(K, ca.DM(rhs - kkt @ X)))  # refinement
-        if not np.all(np.isfinite(X)) or np.max(np.abs(rhs - kkt @ X)) > 1e-8:
-            X = None
+        solver = ca.Linsol("kkt", "ldl", Kr.sparsity())
+        X = np.asarray(solver.solve(Kr, ca.DM(B)))
+        for _ in range(_REFINEMENTS):
+            dX = np.asarray(solver.solve(Kr, ca.DM(B - K @ X)))
+            X = X + dX
+            if not np.all(np.isfinite(X)):
+                break
+            if np.max(np.abs(dX)) <= 1e-10 * max(np.max(np.abs(X)), 1e-300):
+                return X
     except RuntimeError:
-        X = None
-    if X is None:
-        try:
-            X = spla.splu(kkt).solve(rhs)
-        except RuntimeError:
-            return None
-    X = X[:ntheta]
-    if not np.all(np.isfinite(X)) or np.any(np.diag(X) < 0):
-        return None
-    return X
+        pass
+    return spla.splu(K).solve(B)
