@@ -12,6 +12,7 @@ from .component import Attachment, Component, Rig
 from .errors import InputError, UnknownNameError
 from .fixed_mass import FixedMass
 from .hinge import DiaphragmSpring, HingeDamper, HingeSpring, QuadraticDamper
+from .hinge_nonlinear import CubicHingeSpring, HingeFriction, HingeTorqueTerms
 from .model import Model, ModelError
 from .mounted import Mounted
 from .parameter import Param, Parameter
@@ -26,11 +27,14 @@ from .vehicle import VehicleFrame
 __all__ = [
     "Attachment",
     "Component",
+    "CubicHingeSpring",
     "DiaphragmSpring",
     "FixedMass",
     "FreeSpacecraft",
     "HingeDamper",
+    "HingeFriction",
     "HingeSpring",
+    "HingeTorqueTerms",
     "InputError",
     "LateralRig",
     "Model",

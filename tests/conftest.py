@@ -9,6 +9,16 @@ for _var in ("OMP_NUM_THREADS", "OPENBLAS_NUM_THREADS", "MKL_NUM_THREADS", "NUME
     os.environ.setdefault(_var, "1")
 
 _TESTS = Path(__file__).resolve().parent
+# pytest has put tests/ on the path to import this file: its folders tests/estimate,
+# tests/analogs, ... would be found as namespace packages before an editable install of
+# the project, so the project's packages are imported with tests/ off the path
+_path = sys.path[:]
+sys.path[:] = [p for p in sys.path if Path(p or ".").resolve() != _TESTS]
+import analogs  # noqa: E402,F401
+import derive  # noqa: E402,F401
+import estimate  # noqa: E402,F401
+
+sys.path[:] = _path
 if str(_TESTS) not in sys.path:
     sys.path.insert(0, str(_TESTS))
 

@@ -9,7 +9,12 @@ The tank translates by a prescribed ``x(t)`` along the rig axis. Each planar pen
 (bob mass ``m``, length ``L``, hinge spring ``k`` [N m/rad], linear hinge damper ``c``
 [N m s/rad], quadratic hinge damper ``c2`` [N m s^2/rad^2], torque ``c2 thd |thd|``) obeys::
 
-    m L^2 thdd + m L xdd cos(th) + m g L sin(th) + k th + c thd + c2 thd |thd| = 0
+    m L^2 thdd + m L xdd cos(th) + m g L sin(th) + k th + c thd + c2 thd |thd| + T = 0
+
+where ``T`` holds the optional hinge torques of a diaphragm or bearing: a cubic spring
+``k3 th^3`` [N m/rad^3], Coulomb friction ``Tc sign(thd)`` [N m] (made continuous as
+``Tc tanh(thd / 1e-3 rad/s)``, far sharper than the estimation's regularisation) and any
+other torque ``extra(th, thd)`` [N m] a test supplies (effects outside every analog family).
 
 and the force the transducer measures is::
 
@@ -99,6 +104,12 @@ class Pendulum:
         Linear hinge damper c [N m s/rad].
     quadratic_damping : float
         Quadratic hinge damper c2 [N m s^2/rad^2] (torque ``c2 thd |thd|``).
+    cubic_stiffness : float
+        Cubic hinge spring k3 [N m/rad^3] (torque ``k3 th^3``; > 0 hardens).
+    coulomb : float
+        Coulomb (dry) hinge friction Tc [N m] (torque ``Tc sign(thd)``).
+    extra : callable, optional
+        Any further hinge torque ``extra(th, thd)`` [N m], vectorised over arrays.
     """
 
     mass: float
@@ -106,6 +117,9 @@ class Pendulum:
     stiffness: float = 0.0
     damping: float = 0.0
     quadratic_damping: float = 0.0
+    cubic_stiffness: float = 0.0
+    coulomb: float = 0.0
+    extra: object = None
 
 
 def natural_frequency(p: Pendulum, gravity: float = STANDARD_GRAVITY) -> float:
@@ -370,11 +384,23 @@ class Ramped:
 # simulation
 
 
+#: Rate scale of the reference's Coulomb friction [rad/s]: ``Tc tanh(thd / this)``.
+COULOMB_RATE = 1e-3
+
+
+def hinge_torque(p: Pendulum, th: Array, thd: Array) -> Array:
+    """The hinge torques ``k th + c thd + c2 thd|thd| + k3 th^3 + Tc sign(thd) + extra``."""
+    torque = (p.stiffness * th + p.damping * thd + p.quadratic_damping * thd * np.abs(thd)
+              + p.cubic_stiffness * th**3 + p.coulomb * np.tanh(thd / COULOMB_RATE))
+    if p.extra is not None:
+        torque = torque + p.extra(th, thd)
+    return torque
+
+
 def _pendulum_accel(th: Array, thd: Array, xdd: Array, p: Pendulum, g: float) -> Array:
-    """thdd from m L^2 thdd + m L xdd cos th + m g L sin th + k th + c thd + c2 thd|thd| = 0."""
+    """thdd from m L^2 thdd + m L xdd cos th + m g L sin th + T(th, thd) = 0."""
     m, L = p.mass, p.length
-    torque = (m * L * xdd * np.cos(th) + m * g * L * np.sin(th) + p.stiffness * th
-              + p.damping * thd + p.quadratic_damping * thd * np.abs(thd))
+    torque = m * L * xdd * np.cos(th) + m * g * L * np.sin(th) + hinge_torque(p, th, thd)
     return -torque / (m * L**2)
 
 
@@ -393,6 +419,10 @@ def simulate_lateral(
     displacement_noise: float = 0.0,
     tone: Tone | None = None,
     friction: Friction | None = None,
+    offset: float = 0.0,
+    drift: float = 0.0,
+    pink_noise: float = 0.0,
+    saturation: float = 0.0,
     seed: int | None = None,
     rtol: float = 1e-10,
     atol: float = 1e-12,
@@ -423,6 +453,16 @@ def simulate_lateral(
         Motor tone added to the force.
     friction : Friction, optional
         Rig friction seen by the transducer.
+    offset, drift : float, default 0
+        Transducer offset [N] and linear drift [N/s] added to the recorded force.
+    pink_noise : float, default 0
+        Standard deviation of an added 1/f ("pink") force noise as a fraction of the RMS
+        mechanical force (spectrum shaped in the frequency domain from white noise, with the
+        same seed).
+    saturation : float, default 0
+        Transducer soft saturation level [N]: when > 0 the recorded force (with tone,
+        offset and drift, before the noise) is ``saturation * tanh(F / saturation)``, a
+        transducer that reads low on large forces (an effect no analog describes).
     seed : int, optional
         Seed of ``numpy.random.default_rng`` for the noise.
     rtol, atol : float
@@ -461,13 +501,18 @@ def simulate_lateral(
     inertia = m * L**2
     one = np.empty(1)
 
+    plain = all(p.cubic_stiffness == 0 and p.coulomb == 0 and p.extra is None for p in pend)
+
     def rhs(time: float, y: Array) -> Array:
         # the same equation as _pendulum_accel, vectorised over the pendulums for speed
         one[0] = time
         xdd = excitation(one)[2][0]
         th, thd = y[:n_p], y[n_p:]
-        torque = (m * L * xdd * np.cos(th) + m * gravity * L * np.sin(th) + k * th + c * thd
-                  + c2 * thd * np.abs(thd))
+        torque = m * L * xdd * np.cos(th) + m * gravity * L * np.sin(th)
+        if plain:
+            torque = torque + k * th + c * thd + c2 * thd * np.abs(thd)
+        else:
+            torque = torque + np.array([hinge_torque(p, th[i], thd[i]) for i, p in enumerate(pend)])
         return np.concatenate([thd, -torque / inertia])
 
     nfev, message = 0, "no pendulums: nothing to integrate"
@@ -501,8 +546,15 @@ def simulate_lateral(
     clean = mech.copy()
     if tone is not None:
         clean = clean + tone.amplitude * np.sin(2 * np.pi * tone.frequency * tt + tone.phase)
+    if offset or drift:
+        clean = clean + offset + drift * (tt - tt[0])
+    if saturation:
+        clean = saturation * np.tanh(clean / saturation)
     rng = np.random.default_rng(seed)
-    force = clean + rng.normal(0.0, noise * float(np.sqrt(np.mean(mech**2))), tt.size)
+    rms_mech = float(np.sqrt(np.mean(mech**2)))
+    force = clean + rng.normal(0.0, noise * rms_mech, tt.size)
+    if pink_noise:
+        force = force + pink_noise * rms_mech * _pink(tt.size, rng)
     disp = x + rng.normal(0.0, displacement_noise, tt.size) if displacement_noise else x.copy()
     return {
         "time": tt.copy(), "displacement": disp, "displacement_clean": x, "velocity": xd,
@@ -510,3 +562,14 @@ def simulate_lateral(
         "theta": th, "theta_dot": thd, "theta_ddot": thdd, "nfev": float(nfev),
         "message": message,
     }
+
+
+def _pink(n: int, rng: np.random.Generator) -> Array:
+    """Unit-variance noise with a 1/f power spectrum (white noise shaped by 1/sqrt(f))."""
+    spec = np.fft.rfft(rng.normal(size=n))
+    f = np.arange(spec.size, dtype=float)
+    f[0] = 1.0
+    spec = spec / np.sqrt(f)
+    spec[0] = 0.0
+    x = np.fft.irfft(spec, n)
+    return x / np.std(x)

@@ -24,11 +24,12 @@ G = 9.80665
 def make_case(folder: Path, name: str, excitation, *, pendulums=(), fixed_mass=1.456,
               dry_mass=1.2, noise=0.01, displacement_noise=2e-5, duration=30.0, rate=100.0,
               seed=0, prediction: Prediction | None = PREDICTION_60, fill=0.6,
-              diaphragm=False, **effects):
+              diaphragm=False, radius=0.1016, **effects):
     """Simulate with ``reference_models.simulate_lateral`` and write ``name.toml``/``.csv``.
 
     ``excitation`` is a ``reference_models`` excitation; a ``ref.Crank`` writes a crank
-    case without displacement column. Returns ``(case, simulation dict)``.
+    case without displacement column; ``radius`` is the sphere's radius [m]. Returns
+    ``(case, simulation dict)``.
     """
     t = np.arange(int(round(duration * rate)) + 1) / rate
     crank = isinstance(excitation, ref.Crank)
@@ -44,7 +45,7 @@ def make_case(folder: Path, name: str, excitation, *, pendulums=(), fixed_mass=1
         test=TestInfo(id=name, rig="lateral", data=f"{name}.csv",
                       excitation="crank" if crank else "measured",
                       note="SYNTHETIC test data from tests/reference_models.py"),
-        tank=Tank(shape="sphere", radius=0.1016, fill_fraction=fill, diaphragm=diaphragm),
+        tank=Tank(shape="sphere", radius=radius, fill_fraction=fill, diaphragm=diaphragm),
         liquid=Liquid(density=998.2, kinematic_viscosity=1.004e-6),
         rig=rig, time=t, force=sim["force"],
         displacement=None if crank else sim["displacement"], prediction=prediction,

@@ -8,7 +8,7 @@ NOTEBOOKS = sorted((Path(__file__).resolve().parents[1] / "notebooks").glob("*.i
 #: Text each notebook must print: a check that it did its job, not only that it ran.
 EXPECT = {
     "01_fit_lateral_test.ipynb": ["identifiable combination is p1.frequency_hz"],
-    "02_diagnose.ipynb": ["slosh_mode: "],
+    "02_diagnose.ipynb": ["slosh_mode: ", "explains the data"],
     "03_export_and_montecarlo.ipynb": ["Monte Carlo: 200 draws"],
     "04_spinning_rig_and_ntc.ipynb": (["Nutation decays", "Nutation grows"]
                                       + ["NTC, linearised about steady spin"] * 4),

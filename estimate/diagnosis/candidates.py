@@ -7,24 +7,33 @@ import math
 from collections.abc import Callable, Mapping
 from dataclasses import dataclass, field
 
-from analogs import HingeDamper, HingeSpring, Model, Pendulum, QuadraticDamper
+from analogs import HingeDamper, HingeSpring, Model, Pendulum
 
-from ..fitting.measurement import MeasurementModel, RigFriction, SensorDelay
+from ..fitting.measurement import MeasurementModel, SensorDelay
 from ..fitting.result import FitResult
 from .evidence import Evidence
 
-__all__ = ["Proposal", "propose", "CAUSES"]
+__all__ = ["Proposal", "propose", "CAUSES", "MODE_SCORE", "FREQUENCY_OFF"]
 
-#: The causes a diagnosis can name.
-CAUSES = ("slosh_mode", "nonlinear_damping", "diaphragm_stiffness", "sensor_delay",
-          "rig_friction", "rotor")
+#: Score (chi-square reduction over the residual variance) a matched scan must reach for
+#: another slosh mode to be fitted.
+MODE_SCORE = 25.0
+#: A first-mode frequency this far off the free-surface prediction (relative) makes the
+#: diaphragm's hinge spring a candidate even when the case file mentions no diaphragm.
+FREQUENCY_OFF = 0.03
+
+#: The causes a diagnosis can name (documented in the README).
+CAUSES = ("slosh_mode", "nonlinear_damping", "dry_friction", "nonlinear_stiffness",
+          "diaphragm_stiffness", "sensor_delay", "sensor_offset", "rig_friction", "rotor",
+          "hinge_torque")
 
 
 @dataclass(frozen=True)
 class Proposal:
     """One candidate: the extended model and measurement models, initial values and bounds
-    over the current estimates, what it adds, and (for a sensor delay) the delay range to
-    profile. ``plausible(result)`` returns ``None`` or the reason it is not physical."""
+    over the current estimates, what it adds, (for a sensor delay) the delay range to
+    profile, and start values for a fit from the prediction when the current estimates are
+    a poor start. ``plausible(result)`` returns ``None`` or the reason it is not physical."""
 
     cause: str
     added: tuple[str, ...]
@@ -34,8 +43,17 @@ class Proposal:
     bounds: Mapping[str, tuple[float, float]] = field(default_factory=dict)
     hold: Mapping[str, float] = field(default_factory=dict)
     delay_range: tuple[float, float] | None = None
+    #: start values of the new parameters read off the amplitude evidence, for a fit
+    #: started from the tank prediction instead of the current estimates (``None``: none)
+    cold_start: Mapping[str, float] | None = None
     plausible: Callable[[FitResult], str | None] = field(default=lambda r: None, repr=False)
     describe: Callable[[FitResult], str] = field(default=lambda r: "", repr=False)
+
+
+#: Smallest damping ratio of a slosh mode: viscous damping of liquid slosh is ~1e-3 in tanks
+#: up to a metre (Mikishev's law) and higher for higher modes; a fitted "mode" that hardly
+#: decays over a record (damping ratio ~0) is a constant tone in the force.
+MIN_MODE_DAMPING = 2e-4
 
 
 def _has(model: Model, cls, name: str) -> bool:
@@ -67,7 +85,7 @@ def _probe_regression(probe, J, r):
     return -float(coef[0]), explained
 
 
-def scan_mode(current: FitResult, f_lo: float, f_hi: float, *, n: int = 120, case: int = 0,
+def scan_mode(current: FitResult, f_lo: float, f_hi: float, *, n: int = 60, case: int = 0,
               zeta: float = 0.02) -> tuple[float, float, float] | None:
     """Matched scan for an unmodelled slosh mode: for trial frequencies in ``[f_lo, f_hi]``
     simulate a unit-mass pendulum driven by the case's carriage motion and regress the
@@ -93,12 +111,17 @@ def scan_mode(current: FitResult, f_lo: float, f_hi: float, *, n: int = 120, cas
     offset = sum(int(c.time.size) for c in (e.case for e in current.problem.experiments[:case]))
     J = current.sensitivity[offset:offset + t.size][w]
     probe = derive(LateralRig() + Pendulum("q") + HingeDamper("q"))
+    excitation = exp.excitation
+    if current.carriage and current.carriage[case] is not None:  # the estimated motion
+        from derive import Sampled
+
+        excitation = Sampled(t, current.carriage[case])
     best = None
     for f in np.geomspace(f_lo, f_hi, n):
         om = 2 * math.pi * f
         L = g / om**2
         sim = simulate(probe, {"rig.dry_mass": 0.0, "rig.gravity": g, "q.mass": 1.0, "q.length": L,
-                               "q.damping": 2 * zeta * L**2 * om}, t, exp.excitation,
+                               "q.damping": 2 * zeta * L**2 * om}, t, excitation,
                        outputs=("force_x",))
         mass, explained = _probe_regression(sim.outputs[:, 0][w], J, r)
         if mass <= 0:
@@ -193,9 +216,13 @@ def _rotor_proposal(model: Model, measurement, current: FitResult,
 
 
 def propose(model: Model, measurement: tuple[MeasurementModel, ...], current: FitResult,
-            evidence: Evidence, *, gravity: float, predicted: Mapping[str, float],
-            measured_excitation: bool) -> list[Proposal]:
-    """The candidate extensions of ``model`` given the current fit and its evidence."""
+            evidence: Evidence, *, gravity: float, predicted: Mapping[str, float]
+            ) -> list[Proposal]:
+    """The candidate extensions of ``model`` that the score screening cannot rank (they add
+    states, change a held parameter or shift the data): another slosh mode (matched scan),
+    a diaphragm's hinge spring with the length held near the prediction, a sensor delay
+    (profiled, when the residual leans toward a late recording) and, on a rotating rig, a
+    rotor."""
     values = dict(zip(current.names, current.values))
     out: list[Proposal] = []
     if len(current.channels[0] if current.channels else ()) > 1:
@@ -217,21 +244,14 @@ def propose(model: Model, measurement: tuple[MeasurementModel, ...], current: Fi
     scan = (scan_mode(current, 1.15 * f_top, min(0.9 * cutoff, 4.0 * f_top))
             if math.isfinite(f_top) else None)
     f0 = m0 = None
-    if scan is not None and scan[2] > 0.05:
+    statistic = _scan_statistic(current, scan[2]) if scan is not None else 0.0
+    if scan is not None and statistic >= MODE_SCORE:
         f0, m0, explained = scan
         near = [p for p in coherent if abs(p.frequency / f0 - 1) < 0.1]
-        peak_text = (f"{100 * explained:.0f} % of the residual is the response of an oscillator at "
-                     f"{f0:.3g} Hz driven by the carriage"
+        peak_text = (f"{100 * explained:.0f} % of the residual (score {statistic:.0f}) is the "
+                     f"response of an oscillator at {f0:.3g} Hz driven by the carriage"
                      + (f", with a residual peak at {near[0].frequency:.3g} Hz (coherence "
                         f"{near[0].coherence:.2f}) that is not a drive harmonic" if near else ""))
-    elif coherent:
-        top = max(coherent, key=lambda p: p.amplitude)
-        f0 = top.frequency
-        peak_text = (f"residual peak at {f0:.3g} Hz is not a drive harmonic (coherence with the "
-                     f"excitation {top.coherence:.2f})")
-    elif f"{name}.length" in predicted:
-        f0 = math.sqrt(gravity / predicted[f"{name}.length"]) / (2 * math.pi)
-        peak_text = f"the tank's mode {name[1:]} at {f0:.3g} Hz"
     if f0 is not None:
         L0 = gravity / (2 * math.pi * f0) ** 2
         m0 = m0 if m0 is not None else predicted.get(f"{name}.mass", 0.04 * m1)
@@ -245,6 +265,10 @@ def propose(model: Model, measurement: tuple[MeasurementModel, ...], current: Fi
                 return f"{name} mass {m:.3g} kg is not below the lower mode's"
             if not _significant(r, f"{name}.mass", 3.0):
                 return f"{name} mass {m:.3g} kg is not distinguishable from zero"
+            zeta = r.derived.get(f"{name}.damping_ratio", (math.nan, 0.0))[0]
+            if zeta < MIN_MODE_DAMPING:
+                return (f"{name} damping ratio {zeta:.2g}: an oscillation at {f:.3g} Hz that does "
+                        f"not decay over the record is a tone or a structural ringing, not slosh")
             return None
 
         out.append(Proposal(
@@ -260,33 +284,16 @@ def propose(model: Model, measurement: tuple[MeasurementModel, ...], current: Fi
     if p1 is None:
         return out
 
-    # -- nonlinear (quadratic) damping ------------------------------------------------------
-    if not _has(model, QuadraticDamper, p1):
-        c = values.get(f"{p1}.damping", 0.0)
-
-        def plausible_quad(r: FitResult) -> str | None:
-            if not _significant(r, f"{p1}.quadratic_damping", 3.0):
-                return "the quadratic damping is not distinguishable from zero"
-            return None
-
-        spread = evidence.damping_spread
-        out.append(Proposal(
-            "nonlinear_damping", (f"{p1}:quadratic",), model + QuadraticDamper(p1), measurement,
-            {f"{p1}.quadratic_damping": max(c, 1e-6) * 0.5},
-            plausible=plausible_quad,
-            describe=lambda r: (
-                f"damping refitted segment by segment varies by a factor {spread:.2g} with the swing "
-                f"amplitude (correlation {evidence.damping_amplitude_correlation:+.2f}) -> amplitude-"
-                f"dependent (nonlinear) damping; adding a quadratic hinge damper on {p1} "
-                f"(c2 = {r.value(f'{p1}.quadratic_damping'):.3g} N m s^2/rad^2)")))
-
     # -- diaphragm stiffness: hinge spring, length held near the prediction ----------------------
-    if not _has(model, HingeSpring, p1) and f"{p1}.length" in predicted:
+    # only when the case says there is a diaphragm or the frequency is off the prediction
+    ratio = evidence.frequency_ratio
+    off = ratio is not None and abs(ratio - 1) > FREQUENCY_OFF
+    diaphragm = current.problem.experiments[0].case.tank.diaphragm
+    if not _has(model, HingeSpring, p1) and f"{p1}.length" in predicted and (off or diaphragm):
         Lp = predicted[f"{p1}.length"]
         m = values.get(f"{p1}.mass", m1)
         w2 = (2 * math.pi * f1) ** 2 if math.isfinite(f1) else gravity / Lp
         k0 = max(m * Lp**2 * w2 - m * gravity * Lp, 0.05 * m * gravity * Lp)
-        ratio = evidence.frequency_ratio
 
         def plausible_spring(r: FitResult) -> str | None:
             if not _significant(r, f"{p1}.stiffness", 3.0):
@@ -330,20 +337,15 @@ def propose(model: Model, measurement: tuple[MeasurementModel, ...], current: Fi
                             delay_range=(0.0, 0.1), plausible=plausible_delay,
                             describe=describe_delay))
 
-    # -- rig friction seen by the transducer -------------------------------------------------------
-    if measured_excitation and not any(isinstance(mm, RigFriction) for mm in measurement):
-        def plausible_friction(r: FitResult) -> str | None:
-            if not (_significant(r, "rig.friction_viscous", 3.0)
-                    or _significant(r, "rig.friction_coulomb", 3.0)):
-                return "the friction coefficients are not distinguishable from zero"
-            return None
-
-        out.append(Proposal(
-            "rig_friction", ("rig_friction",), model, measurement + (RigFriction(),),
-            {"rig.friction_viscous": 0.1, "rig.friction_coulomb": 0.01},
-            plausible=plausible_friction,
-            describe=lambda r: (
-                f"a force in phase with the carriage velocity -> rig friction seen by the transducer "
-                f"(viscous {r.value('rig.friction_viscous'):.3g} N s/m, Coulomb "
-                f"{r.value('rig.friction_coulomb'):.3g} N)")))
     return out
+
+
+def _scan_statistic(current: FitResult, explained: float, case: int = 0) -> float:
+    """The chi-square reduction a matched scan's explained fraction of the fitted residual
+    stands for, over the residual variance (the score of the scanned candidate)."""
+    import numpy as np
+
+    w = current.weights[case] > 0 if current.weights else slice(None)
+    scale = current.problem.channel_scales(case)["force_x"]
+    r = np.asarray(current.residuals[case])[w] / scale
+    return float(explained * (r @ r) / max(current.residual_variance, 1e-300))

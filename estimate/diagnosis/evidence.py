@@ -14,12 +14,17 @@ from scipy.stats import chi2
 from ..data.signals import find_spectral_peaks, welch_spectrum
 from ..fitting.result import FitResult
 
-__all__ = ["Evidence", "ResidualPeak", "SegmentDamping", "collect_evidence", "noise_floor"]
+__all__ = ["Evidence", "ResidualPeak", "SegmentDamping", "Trend", "amplitude_trend",
+           "collect_evidence", "noise_floor"]
 
 #: Residual peaks weaker than this fraction of the force amplitude are ignored.
 PEAK_FLOOR = 0.003
 #: Relative tolerance for calling a frequency a harmonic of the drive.
 HARMONIC_TOL = 0.03
+#: A residual this many times the measurement noise is within the noise: the white level
+#: read above the signal band may miss some coloured noise inside it, and the level itself
+#: scatters by a few per cent between records.
+NOISE_MARGIN = 1.15
 
 
 @dataclass(frozen=True)
@@ -35,8 +40,8 @@ class ResidualPeak:
 
 @dataclass(frozen=True)
 class SegmentDamping:
-    """Damping ratio and frequency of ``p1`` refitted on one time segment, with the RMS
-    swing angle (rad) and RMS force (N) of that segment."""
+    """Damping ratio and frequency of ``p1`` refitted on one time segment, with their
+    standard errors, the RMS swing angle (rad) and the RMS force (N) of that segment."""
 
     start: float
     stop: float
@@ -44,6 +49,65 @@ class SegmentDamping:
     rms_force: float
     damping_ratio: float
     frequency_hz: float
+    damping_se: float = math.nan
+    frequency_se: float = math.nan
+
+
+@dataclass(frozen=True)
+class Trend:
+    """How a segment quantity changes with the swing amplitude: the weighted straight line
+    through ``(amplitude, value)`` (amplitude in rad), its value at the smallest and largest
+    segment amplitude, and the slope in standard errors (``t``; |t| > 3 is a trend)."""
+
+    quantity: str
+    amplitudes: tuple[float, float]
+    values: tuple[float, float]
+    slope: float
+    slope_se: float
+
+    @property
+    def t(self) -> float:
+        return self.slope / self.slope_se if self.slope_se > 0 else 0.0
+
+    @property
+    def ratio(self) -> float:
+        """Value at the largest amplitude over the value at the smallest."""
+        return self.values[1] / self.values[0] if self.values[0] else math.nan
+
+    def text(self) -> str:
+        """``"damping ratio falls x0.50 from 0.1 rad to 0.35 rad (6.2 standard errors)"``."""
+        moves = "rises" if self.slope > 0 else "falls"
+        if self.quantity == "frequency":
+            change = f"{100 * (self.ratio - 1):+.1f} %"
+        else:
+            change = f"x{self.ratio:.2f}"
+        return (f"{self.quantity} {moves} {change} from {self.amplitudes[0]:.2g} rad to "
+                f"{self.amplitudes[1]:.2g} rad swing ({abs(self.t):.1f} standard errors)")
+
+
+def amplitude_trend(segments: tuple[SegmentDamping, ...], quantity: str) -> Trend | None:
+    """The trend of ``"damping ratio"`` or ``"frequency"`` with the swing amplitude over
+    ``segments`` (at least three with finite values and standard errors), or ``None``."""
+    if quantity == "frequency":
+        rows = [(s.rms_angle, s.frequency_hz, s.frequency_se) for s in segments]
+    else:
+        rows = [(s.rms_angle, s.damping_ratio, s.damping_se) for s in segments]
+    rows = [(math.sqrt(2) * a, v, e) for a, v, e in rows
+            if all(map(math.isfinite, (a, v, e))) and e > 0 and v > 0]
+    if len(rows) < 3:
+        return None
+    a, v, e = (np.array(x) for x in zip(*rows))
+    if np.ptp(a) <= 0.1 * np.max(a):
+        return None  # the swing hardly changes: no amplitude dependence to read
+    A = np.column_stack([np.ones_like(a), a]) / e[:, None]
+    coef, *_ = np.linalg.lstsq(A, v / e, rcond=None)
+    cov = np.linalg.inv(A.T @ A)
+    # the straight line's own scatter: a poor line widens the slope's error
+    chi2_red = float(np.sum((A @ coef - v / e) ** 2)) / max(len(rows) - 2, 1)
+    se = math.sqrt(cov[1, 1] * max(chi2_red, 1.0))
+    lo, hi = float(a.min()), float(a.max())
+    return Trend(quantity, (lo, hi), (float(coef[0] + coef[1] * lo), float(coef[0] + coef[1] * hi)),
+                 float(coef[1]), se)
 
 
 @dataclass(frozen=True)
@@ -65,11 +129,29 @@ class Evidence:
     segments: tuple[SegmentDamping, ...] = field(default=())
     #: Multi-channel cases: each channel's share of the scaled residual power (sums to 1).
     channel_share: dict[str, float] = field(default_factory=dict)
+    #: The residual over the measurement noise: the square root of the fit's residual
+    #: variance when its residuals are divided by their noise levels (estimated input),
+    #: else the RMS residual over the noise in the fitted band.
+    noise_ratio: float = math.nan
+    #: Where the residual concentrates: frequencies (Hz) of its strongest spectral peaks.
+    residual_frequencies: tuple[float, ...] = ()
 
     @property
     def within_noise(self) -> bool:
-        """The residual is no larger than the measurement noise in the fitted band."""
-        return self.rms_residual <= 1.25 * self.noise_rms
+        """The residual is within :data:`NOISE_MARGIN` of the measurement noise."""
+        ratio = self.noise_ratio if math.isfinite(self.noise_ratio) else \
+            self.rms_residual / max(self.noise_rms, 1e-300)
+        return ratio <= NOISE_MARGIN
+
+    @property
+    def damping_trend(self) -> Trend | None:
+        """Damping ratio against the swing amplitude (see :func:`amplitude_trend`)."""
+        return amplitude_trend(self.segments, "damping ratio")
+
+    @property
+    def frequency_trend(self) -> Trend | None:
+        """Frequency against the swing amplitude (see :func:`amplitude_trend`)."""
+        return amplitude_trend(self.segments, "frequency")
 
     @property
     def damping_spread(self) -> float:
@@ -187,12 +269,17 @@ def collect_evidence(result: FitResult, *, case: int = 0, segments: tuple[Segmen
         f_pred = math.sqrt(exp.case.rig.gravity / pred.pendulum_length) / (2 * math.pi)
         ratio = fhat[0] / f_pred
     pinned = tuple(wn.split("`")[1] for wn in result.warnings if "at its bound" in wn)
+    rms = float(np.sqrt(np.mean(res[keep] ** 2)))
+    noise = noise_floor(t, exp.case.force, problem.force_cutoff_hz)
+    weighted = bool(problem.noise) and problem.noise[case] is not None
+    noise_ratio = (math.sqrt(result.residual_variance) if weighted
+                   else rms / max(noise, 1e-300))
     return Evidence(
-        rms_residual=float(np.sqrt(np.mean(res[keep] ** 2))),
-        noise_rms=noise_floor(t, exp.case.force, problem.force_cutoff_hz),
+        rms_residual=rms, noise_rms=noise,
         drive_frequency=drive, sweep=sweep, peaks=tuple(peaks), harmonics=harmonics,
         ljung_box_q=q, ljung_box_p=pval, skew_correlation=corr, skew_delay=delay,
-        frequency_ratio=ratio, pinned=pinned, segments=segments)
+        frequency_ratio=ratio, pinned=pinned, segments=segments, noise_ratio=noise_ratio,
+        residual_frequencies=tuple(p.frequency for p in peaks[:3]))
 
 
 def _multichannel_evidence(result: FitResult, case: int) -> Evidence:
@@ -218,6 +305,8 @@ def _multichannel_evidence(result: FitResult, case: int) -> Evidence:
 
 
 def _carriage_acceleration(result: FitResult, case: int) -> np.ndarray | None:
+    if result.carriage and result.carriage[case] is not None:
+        return np.asarray(result.carriage[case])[2]  # the estimated carriage motion
     exp = result.problem.experiments[case]
     dm = exp.derived
     t = np.asarray(exp.case.time, float)
@@ -227,10 +316,16 @@ def _carriage_acceleration(result: FitResult, case: int) -> np.ndarray | None:
     return None
 
 
-def segment_damping(result: FitResult, *, case: int = 0, n_segments: int = 4) -> tuple[SegmentDamping, ...]:
+def segment_damping(result: FitResult, *, case: int = 0, n_segments: int = 4,
+                    skip: float = 2.0) -> tuple[SegmentDamping, ...]:
     """Refit ``p1``'s damping and length on each of ``n_segments`` time segments (other
     parameters held at the estimates, the segment's initial state free) and report the
-    damping ratio and frequency against the segment's swing amplitude."""
+    damping ratio and frequency, with their standard errors, against the segment's swing
+    amplitude (the RMS of the fitted angle).
+
+    The segments share the record after its first ``skip`` seconds (at most a tenth of it):
+    a start-up ramp is not a steady swing. They are fitted with the filtered input (fast;
+    the start-up, where filtering errs, is left out)."""
     from ..fitting.nlp import fit
     from ..fitting.problem import FitProblem
 
@@ -240,10 +335,12 @@ def segment_damping(result: FitResult, *, case: int = 0, n_segments: int = 4) ->
     if exp.case.test.rig != "lateral" or not {"p1.damping", "p1.length"} <= names:
         return ()
     values = problem.case_values(case, result.values)
-    sim = exp.simulate(values)
-    theta = sim.state("p1.theta") if "p1.theta" in sim.state_names else None
+    coords = exp.derived.coordinates
+    theta = (result.states[case][coords.index("p1.theta")]
+             if result.states and "p1.theta" in coords else None)
     c = exp.case
-    edges = np.linspace(0, c.time.size - 1, n_segments + 1).astype(int)
+    start = int(np.searchsorted(c.time, c.time[0] + min(skip, 0.1 * (c.time[-1] - c.time[0]))))
+    edges = np.linspace(start, c.time.size - 1, n_segments + 1).astype(int)
     out = []
     hold = {k: v for k, v in values.items() if k not in ("p1.damping", "p1.length")
             and k in result.problem.experiments[case].derived.needed_parameters()}
@@ -256,13 +353,14 @@ def segment_damping(result: FitResult, *, case: int = 0, n_segments: int = 4) ->
                                                        "p1.length": values["p1.length"]},
                                    bounds={"p1.length": (0.5 * values["p1.length"],
                                                          2.0 * values["p1.length"])},
-                                   force_cutoff_hz=problem.force_cutoff_hz, input=problem.input)
+                                   input="filtered")
             r = fit(sub, initial_state="free", progress=False, robust_start=False)
         except (ValueError, RuntimeError):
             continue
-        zeta = r.derived.get("p1.damping_ratio", (math.nan, 0))[0]
-        fz = r.derived.get("p1.frequency_hz", (math.nan, 0))[0]
+        zeta, zeta_se = r.derived.get("p1.damping_ratio", (math.nan, math.nan))
+        fz, fz_se = r.derived.get("p1.frequency_hz", (math.nan, math.nan))
         swing = float(np.sqrt(np.mean(theta[a:b + 1] ** 2))) if theta is not None else math.nan
         out.append(SegmentDamping(float(c.time[a]), float(c.time[b]), swing,
-                                  float(np.sqrt(np.mean(c.force[a:b + 1] ** 2))), float(zeta), float(fz)))
+                                  float(np.sqrt(np.mean(c.force[a:b + 1] ** 2))), float(zeta),
+                                  float(fz), float(zeta_se), float(fz_se)))
     return tuple(out)

@@ -10,7 +10,7 @@ import numpy as np
 
 from ..data.signals import welch_spectrum
 from ..fitting.result import FitResult
-from .search import Diagnosis
+from .outcome import Diagnosis
 
 __all__ = ["write_report", "summary"]
 
@@ -45,8 +45,10 @@ def summary(d: Diagnosis) -> str:
         for i, f in enumerate(d.findings, 1):
             lines.append(f"{i}. **{f.cause}** (added {', '.join(f.added)}): {f.evidence}.")
     else:
-        lines.append("**No finding.** The baseline analog explains the data: no candidate extension "
-                     "improved the held-out residual significantly.")
+        lines.append("**No finding.** No candidate extension improved the held-out residual "
+                     "significantly.")
+    if d.verdict is not None:
+        lines += ["", f"**Verdict.** {d.verdict.text}"]
     lines += ["", f"Final model: {' + '.join(d.final.problem.model.names)}"
               + (f" with {', '.join(type(m).__name__ for m in d.final.problem.measurement)}"
                  if d.final.problem.measurement else "")

@@ -68,16 +68,12 @@ def uncertainty(jac_residuals: sps.spmatrix, jac_constraints: sps.spmatrix,
     nw, ng = Je.shape[1], Jg.shape[0]
     k = nw - ng  # estimated quantities: variables the constraints leave free
     sigma2 = float(residuals @ residuals) / max(n_observations - k, 1)
-    S = parameter_information(Je, Jg, ntheta)
-    # a prior of relative standard deviation 1e3 on every (scaled) parameter: nothing for
-    # what the data determine, a huge finite variance for a direction they do not
-    lam, V = np.linalg.eigh(0.5 * (S + S.T))
+    kkt = ReducedKKT(Je, Jg, ntheta)
     warnings = []
-    if lam.min() <= _PRIOR_INFORMATION * max(lam.max(), 1.0) * 1e-3:
+    if kkt.singular:
         warnings.append("the residual sensitivity is singular: the data do not determine some "
                         "directions of the parameters (see the identifiability check)")
-    X = (V / np.maximum(lam, _PRIOR_INFORMATION)) @ V.T
-    cov = sigma2 * X * np.outer(scales, scales)
+    cov = sigma2 * kkt.inverse_information * np.outer(scales, scales)
     d = np.sqrt(np.clip(np.diag(cov), 0, None))
     with np.errstate(invalid="ignore", divide="ignore"):
         corr = np.clip(np.nan_to_num(cov / np.outer(d, d)), -1.0, 1.0)
@@ -85,34 +81,78 @@ def uncertainty(jac_residuals: sps.spmatrix, jac_constraints: sps.spmatrix,
     return Uncertainty(cov, d, corr, sigma2, ident, tuple(warnings))
 
 
-#: Information floor of each scaled parameter's direction (relative variance 1e6 at most).
+#: Information floor of each scaled parameter's direction (relative variance 1e6 at most):
+#: a weak prior that is nothing for what the data determine, and a huge finite variance
+#: for a direction they do not.
 _PRIOR_INFORMATION = 1e-6
 #: Refinement steps allowed before the pivoted LU takes over.
 _REFINEMENTS = 8
 
 
+class ReducedKKT:
+    """The Gauss-Newton KKT matrix ``[[H, Jg^T], [Jg, 0]]`` (``H = Je^T Je``) of an
+    equality-constrained least-squares problem, reduced onto its first ``ntheta`` variables
+    (the parameters): every other variable (states, carriage coefficients, free initial
+    states) is eliminated with one sparse factorisation of its own KKT block ``K0``.
+
+    ``information`` is the Schur complement ``H_tt - B^T K0^-1 B`` (the parameters'
+    Gauss-Newton information with the rest marginalised), ``inverse_information`` its
+    inverse (eigenvalues floored by a weak prior); :meth:`step` solves the whole system."""
+
+    def __init__(self, Je: sps.spmatrix, Jg: sps.spmatrix, ntheta: int) -> None:
+        Je, Jg = sps.csc_matrix(Je), sps.csc_matrix(Jg)
+        H = (Je.T @ Je).tocsc()
+        p = ntheta
+        self.ntheta, self.nw, self.ng = p, H.shape[0], Jg.shape[0]
+        self.Je, self.Jg = Je, Jg
+        self.Htt = H[:p, :p].toarray()
+        Hrr, Hrt = H[p:, p:], H[p:, :p]
+        Gr, Gt = Jg[:, p:], Jg[:, :p]
+        self.n_primal = Hrr.shape[0]
+        if self.n_primal + self.ng == 0:
+            self._solve, self.B, self.Y = None, np.zeros((0, p)), np.zeros((0, p))
+        else:
+            K0 = sps.bmat([[Hrr, Gr.T], [Gr, None]], format="csc") if self.ng else Hrr
+            self.B = sps.vstack([Hrt, Gt]).toarray() if self.ng else Hrt.toarray()
+            self._solve = _factorise(K0, self.n_primal)
+            self.Y = self._solve(self.B)
+        S = self.Htt - self.B.T @ self.Y
+        self.information = 0.5 * (S + S.T)
+        lam, V = np.linalg.eigh(self.information)
+        self.singular = bool(lam.min() <= _PRIOR_INFORMATION * max(lam.max(), 1.0) * 1e-3)
+        self.inverse_information = (V / np.maximum(lam, _PRIOR_INFORMATION)) @ V.T
+
+    def gradient(self, residuals: np.ndarray, constraints: np.ndarray | None = None) -> np.ndarray:
+        """The reduced steepest-descent direction of the parameters, ``-dS/dtheta / 2`` with
+        every other variable following (states through the linearised constraints, nuisance
+        variables re-optimised): with :attr:`information` ``S``, the Gauss-Newton step of
+        the parameters is ``S^-1 b`` and it lowers the objective by ``b^T S^-1 b``."""
+        g = np.zeros(self.ng) if constraints is None else np.asarray(constraints, float)
+        b = -(self.Je.T @ residuals)
+        b_t, b_r = b[:self.ntheta], np.r_[b[self.ntheta:], -g]
+        y = self._solve(b_r[:, None])[:, 0] if self._solve is not None else b_r
+        return b_t - self.B.T @ y
+
+    def step(self, residuals: np.ndarray, constraints: np.ndarray | None = None) -> np.ndarray:
+        """The Gauss-Newton step ``dw`` of all variables from a point with ``residuals`` ``e``
+        and constraint values ``g``: minimises ``|e + Je dw|^2`` subject to
+        ``g + Jg dw = 0``."""
+        g = np.zeros(self.ng) if constraints is None else np.asarray(constraints, float)
+        b = -(self.Je.T @ residuals)
+        b_t, b_r = b[:self.ntheta], np.r_[b[self.ntheta:], -g]
+        y = self._solve(b_r[:, None])[:, 0] if self._solve is not None else b_r
+        x_t = self.inverse_information @ (b_t - self.B.T @ y)
+        x_r = y - self.Y @ x_t
+        return np.r_[x_t, x_r[:self.n_primal]]
+
+
 def parameter_information(Je: sps.spmatrix, Jg: sps.spmatrix, ntheta: int) -> np.ndarray:
-    """Gauss-Newton information of the first ``ntheta`` variables, every other variable
-    eliminated through the constraints or marginalised: the Schur complement
-    ``H_tt - B^T K0^-1 B`` of the KKT matrix ``[[H, Jg^T], [Jg, 0]]`` (``H = Je^T Je``) onto
-    them, with ``K0`` the KKT matrix of the other variables (parameters held)."""
-    Je = sps.csc_matrix(Je)
-    Jg = sps.csc_matrix(Jg)
-    H = (Je.T @ Je).tocsc()
-    p = ntheta
-    Htt = H[:p, :p].toarray()
-    if H.shape[0] == p and Jg.shape[0] == 0:
-        return Htt  # nothing but parameters (a rigid tank: no states, no constraints)
-    Hrr, Hrt = H[p:, p:], H[p:, :p]
-    Gr, Gt = Jg[:, p:], Jg[:, :p]
-    K0 = sps.bmat([[Hrr, Gr.T], [Gr, None]], format="csc") if Jg.shape[0] else Hrr
-    B = sps.vstack([Hrt, Gt]).toarray() if Jg.shape[0] else Hrt.toarray()
-    Y = _solve(K0, B, n_primal=Hrr.shape[0])
-    return Htt - B.T @ Y
+    """Gauss-Newton information of the first ``ntheta`` variables (see :class:`ReducedKKT`)."""
+    return ReducedKKT(Je, Jg, ntheta).information
 
 
-def _solve(K: sps.csc_matrix, B: np.ndarray, n_primal: int) -> np.ndarray:
-    """``K^-1 B`` for a KKT matrix ``K`` (``n_primal`` primal rows first).
+def _factorise(K: sps.csc_matrix, n_primal: int):
+    """A function ``B -> K^-1 B`` for a KKT matrix ``K`` (``n_primal`` primal rows first).
 
     ``K`` is made quasi-definite by ``+delta I`` and ``-eps I`` diagonal blocks far below its
     entries (1e-15 relative), which CasADi's sparse LDL^T factorises without pivoting;
@@ -129,14 +169,25 @@ def _solve(K: sps.csc_matrix, B: np.ndarray, n_primal: int) -> np.ndarray:
     Kr = sparse_dm((K + reg).tocsc())
     try:
         solver = ca.Linsol("kkt", "ldl", Kr.sparsity())
-        X = np.asarray(solver.solve(Kr, ca.DM(B)))
-        for _ in range(_REFINEMENTS):
-            dX = np.asarray(solver.solve(Kr, ca.DM(B - K @ X)))
-            X = X + dX
-            if not np.all(np.isfinite(X)):
-                break
-            if np.max(np.abs(dX)) <= 1e-10 * max(np.max(np.abs(X)), 1e-300):
-                return X
     except RuntimeError:
-        pass
-    return spla.splu(K).solve(B)
+        solver = None
+    lu: list = []
+
+    def solve(B: np.ndarray) -> np.ndarray:
+        if solver is not None:
+            try:
+                X = np.asarray(solver.solve(Kr, ca.DM(B)))
+                for _ in range(_REFINEMENTS):
+                    dX = np.asarray(solver.solve(Kr, ca.DM(B - K @ X)))
+                    X = X + dX
+                    if not np.all(np.isfinite(X)):
+                        break
+                    if np.max(np.abs(dX)) <= 1e-10 * max(np.max(np.abs(X)), 1e-300):
+                        return X
+            except RuntimeError:
+                pass
+        if not lu:
+            lu.append(spla.splu(K))
+        return lu[0].solve(B)
+
+    return solve

@@ -16,7 +16,7 @@ from scipy.interpolate import CubicSpline
 
 from analogs import Param
 
-__all__ = ["MeasurementModel", "RigFriction", "SensorDelay"]
+__all__ = ["MeasurementModel", "RigFriction", "SensorDelay", "SensorOffset"]
 
 
 class MeasurementModel:
@@ -25,8 +25,10 @@ class MeasurementModel:
     #: Parameters by full dotted name.
     parameters: Mapping[str, Param] = {}
 
-    def term(self, u: ca.DM, inputs: tuple[str, ...], p: Mapping[str, ca.MX]) -> ca.MX | None:
-        """Force (N) added to the simulated force at the samples, or ``None``."""
+    def term(self, u: ca.DM, inputs: tuple[str, ...], p: Mapping[str, ca.MX],
+             t: np.ndarray) -> ca.MX | None:
+        """Force (N) added to the simulated force at the sample times ``t`` (s), given the
+        inputs ``u`` there, or ``None``."""
         return None
 
     def measured(self, t: np.ndarray, force: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
@@ -49,12 +51,28 @@ class RigFriction(MeasurementModel):
         "rig.friction_coulomb": Param("N", 0.0, 0.0, description="Coulomb carriage friction"),
     }
 
-    def term(self, u, inputs, p):
+    def term(self, u, inputs, p, t):
         if "rig.x_dot" not in inputs:
             raise ValueError("RigFriction needs the carriage velocity input `rig.x_dot` "
                              "(a measured-displacement case)")
         xd = u[inputs.index("rig.x_dot"), :].T
         return p["rig.friction_viscous"] * xd + p["rig.friction_coulomb"] * ca.tanh(xd / self.v_smooth)
+
+
+@dataclass(frozen=True)
+class SensorOffset(MeasurementModel):
+    """A transducer that is not zeroed and drifts: ``F_rec = F + offset + drift (t - t0)``.
+
+    Parameters ``rig.force_offset`` (N) and ``rig.force_drift`` (N/s)."""
+
+    parameters = {
+        "rig.force_offset": Param("N", 0.0, description="force transducer offset"),
+        "rig.force_drift": Param("N/s", 0.0, description="force transducer drift rate"),
+    }
+
+    def term(self, u, inputs, p, t):
+        t = np.asarray(t, float)
+        return p["rig.force_offset"] + p["rig.force_drift"] * ca.DM(t - t[0])
 
 
 @dataclass(frozen=True)

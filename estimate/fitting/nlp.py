@@ -62,7 +62,7 @@ def fit(problem: FitProblem, *, transcription: Transcription = MultipleShooting(
         hessian: Hessian = Hessian(), cost: str = "squared", initial_state: str = "rest",
         solver_options: Mapping[str, object] | None = None,
         progress: bool | None = None, robust_start: bool = True,
-        compile_: bool | None = None) -> FitResult:
+        compile_: bool | None = None, warm_start: FitResult | None = None) -> FitResult:
     """Estimate the parameters of ``problem``.
 
     Parameters
@@ -91,6 +91,10 @@ def fit(problem: FitProblem, *, transcription: Transcription = MultipleShooting(
     robust_start : bool, default True
         Initialise crank speed corrections from the force spectrum and flywheel angles
         from a grid over their bounds (:func:`estimate.fitting.initial.crank_start`).
+    warm_start : FitResult, optional
+        A previous fit of the same cases (e.g. of a smaller model): its states start the
+        transcription where the coordinates agree and its estimated carriage motion starts
+        this one's. The parameters start at ``problem``'s initial values.
 
     Returns
     -------
@@ -118,16 +122,10 @@ def fit(problem: FitProblem, *, transcription: Transcription = MultipleShooting(
             problem = problem.with_initial(start)
     est = problem.estimated
     scales = np.array([e.scale for e in est])
-    theta_s = ca.MX.sym("theta", len(est))
     # the exact Hessian differentiates g twice: keep g an AD-able expression then
     blocks_ok = hessian.kind == "gauss-newton"
-    if compile_ is None:
-        from derive._compile import c_compiler
-
-        compile_ = blocks_ok and c_compiler() is not None
-    terms = [case_terms(problem, i, theta_s, transcription, cost, initial_state,
-                         blocks_ok, compile_) for i in range(len(problem.experiments))]
-    nlp = _Nlp.assemble(theta_s, problem.initial / scales, terms)
+    nlp, terms = _setup(problem, transcription, cost, initial_state, blocks_ok, compile_,
+                        warm_start)
     opts = dict(_IPOPT_DEFAULTS)
     opts.update(nlp.derivative_options(hessian, blocks_ok))
     recorder = Recorder(nlp.w.numel(), nlp.g.numel(), len(est), scales, 2 * nlp.norm,
@@ -151,9 +149,84 @@ def fit(problem: FitProblem, *, transcription: Transcription = MultipleShooting(
                      for i in range(k))
     xres = tuple(None if terms[i].displacement_residual is None
                  else np.asarray(out[4 + k + i]).ravel() for i in range(k))
+    states = tuple(np.asarray(out[4 + 2 * k + i]) for i in range(k))
+    coefs = tuple(np.asarray(out[4 + 3 * k + i]).ravel() if terms[i].coef.numel() else None
+                  for i in range(k))
     return _result(problem, theta, solver.stats(), recorder, terms,
                    *(np.asarray(out[j]).ravel() for j in (0, 2, 3)), J, Je, Jg, t_start,
-                   transcription, cost, carriage, xres)
+                   transcription, cost, carriage, xres, states, coefs)
+
+
+def _setup(problem: FitProblem, transcription: Transcription, cost: str, initial_state: str,
+           blocks_ok: bool, compile_: bool | None, warm_start: FitResult | None):
+    """The assembled NLP of ``problem`` and its per-case terms."""
+    if compile_ is None:
+        from derive._compile import c_compiler
+
+        compile_ = blocks_ok and c_compiler() is not None
+    scales = np.array([e.scale for e in problem.estimated])
+    theta_s = ca.MX.sym("theta", len(problem.estimated))
+    warm = _warm_starts(problem, warm_start)
+    terms = [case_terms(problem, i, theta_s, transcription, cost, initial_state,
+                        blocks_ok, compile_, warm[i]) for i in range(len(problem.experiments))]
+    return _Nlp.assemble(theta_s, problem.initial / scales, terms), terms
+
+
+@dataclass(frozen=True)
+class Linearisation:
+    """A problem's weighted least-squares objective around its start, every variable but the
+    parameters eliminated (states through the dynamics, the carriage motion and free
+    initial states re-optimised): ``objective`` there, the reduced gradient ``gradient``
+    (``-dS/dtheta / 2``) and ``information`` ``S`` of the scaled parameters, in the order
+    of ``names``, with their ``scales`` and start ``values``.
+
+    :meth:`score` gives what freeing some parameters would gain."""
+
+    names: tuple[str, ...]
+    scales: np.ndarray
+    values: np.ndarray
+    objective: float
+    gradient: np.ndarray
+    information: np.ndarray
+
+    def score(self, free: tuple[str, ...]) -> tuple[float, dict[str, float]]:
+        """The objective reduction of one Gauss-Newton step in the parameters ``free`` (the
+        others held at their start values), and the parameters after it (by name, unscaled).
+
+        At the optimum of a model, with a candidate's new parameters at their null values,
+        the reduction over the residual variance is the score (Lagrange multiplier)
+        statistic of the candidate: chi-square with as many degrees of freedom as new
+        parameters when the candidate explains nothing."""
+        idx = [self.names.index(n) for n in free]
+        S = self.information[np.ix_(idx, idx)]
+        b = self.gradient[idx]
+        x = np.linalg.lstsq(S, b, rcond=1e-12)[0]
+        after = {n: float((self.values[i] / self.scales[i] + xi) * self.scales[i])
+                 for n, i, xi in zip(free, idx, x)}
+        return float(b @ x), after
+
+
+def linearise(problem: FitProblem, *, warm_start: FitResult | None = None,
+              transcription: Transcription = MultipleShooting(),
+              initial_state: str = "rest") -> Linearisation:
+    """The :class:`Linearisation` of ``problem`` at its initial values, its states and
+    carriage motion starting from ``warm_start`` (the current fit): what fitting it would
+    gain, predicted without solving (one sparse factorisation)."""
+    from .covariance import ReducedKKT
+
+    est = problem.estimated
+    nlp, _ = _setup(problem, transcription, "squared", initial_state, True, False, warm_start)
+    w0 = nlp.w0
+    e, Je = ca.Function("e", [nlp.w], [nlp.e, nlp.jac_r])(w0)
+    e, Je = np.asarray(e).ravel(), Je.sparse()
+    jac_g = nlp.constraint_jacobian(True)
+    g, Jg = (jac_g(w0, []) if jac_g is not None
+             else ca.Function("g", [nlp.w], [nlp.g, ca.jacobian(nlp.g, nlp.w)])(w0))
+    g = np.asarray(g).ravel()
+    kkt = ReducedKKT(Je, Jg.sparse(), len(est))
+    scales = np.array([x.scale for x in est])
+    return Linearisation(problem.names, scales, problem.initial, float(e @ e),
+                         kkt.gradient(e, g), kkt.information)
 
 
 @dataclass(frozen=True)
@@ -214,24 +287,9 @@ class _Nlp:
     def derivative_options(self, hessian: Hessian, blocks_ok: bool) -> dict:
         """``jac_g`` assembled from per-interval blocks and the Gauss-Newton ``hess_lag``."""
         opts: dict = {}
-        blocks = [t.block for t in self.terms]
-        if blocks_ok and all(b.jac_w is not None or b.g.numel() == 0 for b in blocks):
-            rows_t, locals_, g_fast = [], [], []
-            for t in self.terms:
-                b, nc = t.block, t.coef.numel()
-                if b.g.numel():
-                    jc = b.jac_c if b.jac_c is not None else ca.MX(b.g.numel(), nc)
-                    rows_t.append(b.jac_theta)
-                    local = ca.horzcat(b.jac_w, jc)
-                    g_fast.append(b.g_fast)
-                else:
-                    local = ca.MX(0, b.w.numel() + nc)
-                locals_.append(local)
-            if rows_t:
-                J = ca.horzcat(ca.vertcat(*rows_t), ca.diagcat(*locals_))
-                opts["jac_g"] = ca.Function("nlp_jac_g", [self.w, ca.MX(0, 1)],
-                                            [ca.vertcat(*g_fast), J], ["x", "p"],
-                                            ["g", "jac_g_x"])
+        jac_g = self.constraint_jacobian(blocks_ok)
+        if jac_g is not None:
+            opts["jac_g"] = jac_g
         if hessian.kind == "gauss-newton":
             Jr = self.jac_r
             sigma = ca.MX.sym("sigma")
@@ -241,6 +299,28 @@ class _Nlp:
                                            [ca.triu(H)], ["x", "p", "lam_f", "lam_g"],
                                            ["triu_hess_gamma_x_x"])
         return opts
+
+    def constraint_jacobian(self, blocks_ok: bool) -> ca.Function | None:
+        """``w -> (g, dg/dw)`` assembled from per-interval blocks, or ``None`` (then CasADi
+        differentiates ``g``)."""
+        blocks = [t.block for t in self.terms]
+        if not (blocks_ok and all(b.jac_w is not None or b.g.numel() == 0 for b in blocks)):
+            return None
+        rows_t, locals_, g_fast = [], [], []
+        for t in self.terms:
+            b, nc = t.block, t.coef.numel()
+            if b.g.numel():
+                jc = b.jac_c if b.jac_c is not None else ca.MX(b.g.numel(), nc)
+                rows_t.append(b.jac_theta)
+                locals_.append(ca.horzcat(b.jac_w, jc))
+                g_fast.append(b.g_fast)
+            else:
+                locals_.append(ca.MX(0, b.w.numel() + nc))
+        if not rows_t:
+            return None
+        J = ca.horzcat(ca.vertcat(*rows_t), ca.diagcat(*locals_))
+        return ca.Function("nlp_jac_g", [self.w, ca.MX(0, 1)], [ca.vertcat(*g_fast), J],
+                           ["x", "p"], ["g", "jac_g_x"])
 
     def error_function(self, cost: str) -> ca.Function:
         """``w -> (e, de/dw, raw, report, carriage..., displacement residuals...)``: what the
@@ -253,14 +333,17 @@ class _Nlp:
         xres = [t.displacement_residual if t.displacement_residual is not None else ca.MX(0, 1)
                 for t in self.terms]
         jac = self.jac_r if same else ca.jacobian(e, self.w)
-        return ca.Function("residuals", [self.w], [e, jac, raw, report, *extra, *xres])
+        states = [t.block.X for t in self.terms]
+        coefs = [t.coef for t in self.terms]
+        return ca.Function("residuals", [self.w],
+                           [e, jac, raw, report, *extra, *xres, *states, *coefs])
 
 
 def _result(problem: FitProblem, theta: np.ndarray, stats: dict, recorder: Recorder,
             terms: list[CaseTerms], e: np.ndarray, raw: np.ndarray, report: np.ndarray,
             J: np.ndarray, Je: sps.spmatrix, Jg: sps.spmatrix, t_start: float,
             transcription: Transcription, cost_kind: str, carriage: tuple,
-            displacement_residuals: tuple) -> FitResult:
+            displacement_residuals: tuple, states: tuple, coefficients: tuple) -> FitResult:
     measured = [t.measured for t in terms]
     weights = [t.weights for t in terms]
     nch = [1 if np.ndim(m) == 1 else m.shape[1] for m in measured]
@@ -305,6 +388,24 @@ def _result(problem: FitProblem, theta: np.ndarray, stats: dict, recorder: Recor
         weights=tuple(weights),
         measured=tuple(measured), cost_kind=cost_kind, transcription=repr(transcription),
         carriage=carriage, displacement_residuals=displacement_residuals,
+        states=states, carriage_coefficients=coefficients,
         objective=float(e @ e), residual_variance=unc.sigma2,
         dof=max(n_force + n_disp - (Je.shape[1] - Jg.shape[0]), 1),
     )
+
+
+def _warm_starts(problem: FitProblem, previous: FitResult | None) -> list:
+    """Per case, where its variables start: a previous solution of the same case, or None."""
+    from .terms import WarmStart
+
+    out = []
+    for i, exp in enumerate(problem.experiments):
+        prev = None
+        if previous is not None and i < len(previous.problem.experiments) and previous.states:
+            old = previous.problem.experiments[i]
+            if old.case.path == exp.case.path and old.case.n_samples == exp.case.n_samples:
+                coefs = previous.carriage_coefficients[i] if previous.carriage_coefficients \
+                    else None
+                prev = WarmStart(old.derived.coordinates, previous.states[i], coefs)
+        out.append(prev)
+    return out

@@ -98,6 +98,11 @@ class FitResult:
     carriage: tuple[np.ndarray | None, ...] = field(default=(), repr=False)
     #: Per case, estimated minus measured carriage displacement (m), or ``None``.
     displacement_residuals: tuple[np.ndarray | None, ...] = field(default=(), repr=False)
+    #: Per case, the states at the samples ``(nx, samples)`` and the estimated carriage
+    #: motion's coefficients (``None`` when the input was used as given): what a later fit
+    #: of the same cases starts from (``fit(..., warm_start=result)``).
+    states: tuple[np.ndarray, ...] = field(default=(), repr=False)
+    carriage_coefficients: tuple[np.ndarray | None, ...] = field(default=(), repr=False)
     #: The weighted least-squares objective at the optimum (force and displacement residuals
     #: in units of their scales), the residual variance ``objective / dof`` that scales the
     #: covariance, and the degrees of freedom (observations minus estimated quantities,

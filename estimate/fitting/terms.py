@@ -19,7 +19,7 @@ from ._sparse import sparse_dm
 from .problem import FitProblem
 from .transcription import Block, InputCoefficients, Transcription
 
-__all__ = ["CaseTerms", "case_terms"]
+__all__ = ["CaseTerms", "WarmStart", "case_terms"]
 
 
 def _measured_output(dm, channels: tuple[str, ...]) -> ca.Function:
@@ -99,7 +99,8 @@ class CaseTerms:
 
 
 def case_terms(problem: FitProblem, i: int, theta_s: ca.MX, transcription: Transcription,
-                cost: str, initial_state: str, blocks_ok: bool, compile_: bool) -> CaseTerms:
+               cost: str, initial_state: str, blocks_ok: bool, compile_: bool,
+               warm: "WarmStart | None" = None) -> CaseTerms:
     exp = problem.experiments[i]
     dm, case = exp.derived, exp.case
     t = np.asarray(case.time, float)
@@ -120,13 +121,18 @@ def case_terms(problem: FitProblem, i: int, theta_s: ca.MX, transcription: Trans
         A_grid = carriage.inputs_matrix(t)
         Ug = ca.reshape(ca.mtimes(sparse_dm(A_grid), c), dm.nu, n)
         coefficients = InputCoefficients(c, A_stage)
-        excitation = Sampled(t, carriage.values(carriage.coefficients, t))
-        coef, coef0 = c, carriage.coefficients
+        coef0 = carriage.coefficients
+        if warm is not None and warm.carriage is not None and warm.carriage.size == coef0.size:
+            coef0 = warm.carriage
+        excitation = Sampled(t, carriage.values(coef0, t))
+        coef = c
     else:
         U = ca.DM(transcription.inputs(excitation, t, dm.nu))
         Ug = ca.DM(excitation.values(t) if dm.nu else np.zeros((0, n)))
         coef, coef0 = ca.MX(0, 1), np.zeros(0)
-    if dm.nx:
+    if warm is not None and warm.coordinates == dm.coordinates and warm.states is not None:
+        guess = warm.states
+    elif dm.nx:
         values0 = problem.case_values(i, problem.initial)
         guess = simulate(dm, values0, t, excitation, integrator=RK4()).states.T
     else:
@@ -139,7 +145,7 @@ def case_terms(problem: FitProblem, i: int, theta_s: ca.MX, transcription: Trans
     mvals = {e.parameter: theta_s[j] * e.scale for j, e in enumerate(problem.estimated)
              if e.case in (None, i)}
     for mm in problem.measurement:
-        extra = mm.term(Ug, dm.inputs, mvals)
+        extra = mm.term(Ug, dm.inputs, mvals, t)
         if extra is not None:
             Y = Y + extra
     F, wts = _measured_force(problem, i)
@@ -172,8 +178,18 @@ def case_terms(problem: FitProblem, i: int, theta_s: ca.MX, transcription: Trans
         e = ca.vertcat(e, ex)
         r = e if cost == "squared" else ca.vertcat(r, ex)
     return CaseTerms(block, coef, coef0, r, e, raw, report, F, wts,
-                      scaled_measured, x0 is None,
-                      None if carriage is None else ca.reshape(Ug, dm.nu, n), x_resid)
+                     scaled_measured, x0 is None,
+                     None if carriage is None else ca.reshape(Ug, dm.nu, n), x_resid)
+
+
+@dataclass(frozen=True)
+class WarmStart:
+    """Where a case's NLP variables start: the states ``(nx, samples)`` of a previous
+    solution (used when its coordinates are this model's) and its carriage coefficients."""
+
+    coordinates: tuple[str, ...]
+    states: np.ndarray | None
+    carriage: np.ndarray | None
 
 
 #: The inputs an estimated carriage motion supplies, in the order of its spline's rows.

@@ -1,0 +1,171 @@
+"""What a diagnosis concludes: the candidates tried, the findings accepted, and the verdict
+on the residual that remains."""
+
+from __future__ import annotations
+
+import math
+from dataclasses import dataclass, field
+from typing import Any
+
+from ..fitting.measurement import SensorDelay
+from ..fitting.result import FitResult
+from .evidence import NOISE_MARGIN, Evidence
+
+__all__ = ["CandidateOutcome", "Finding", "Verdict", "Diagnosis"]
+
+
+@dataclass(frozen=True)
+class CandidateOutcome:
+    """A candidate that was screened or refitted: held-out RMS before/after (N), gain, the
+    held-out chi-square reduction, BIC change, its score statistic, and why it was not
+    accepted (``None`` when it qualified)."""
+
+    cause: str
+    added: tuple[str, ...]
+    rms_before: float
+    rms_after: float
+    gain: float
+    bic_change: float
+    rejected: str | None
+    evidence: str
+    result: FitResult = field(repr=False)
+    heldout_chi2: float = math.nan
+    score: float = math.nan
+
+
+@dataclass(frozen=True)
+class Finding:
+    """An accepted extension with its cause and evidence."""
+
+    cause: str
+    evidence: str
+    added: tuple[str, ...]
+    rms_before: float
+    rms_after: float
+    gain: float
+    bic_change: float
+
+    def to_dict(self) -> dict[str, Any]:
+        return {"cause": self.cause, "evidence": self.evidence, "added": list(self.added),
+                "rms_before": self.rms_before, "rms_after": self.rms_after,
+                "gain": self.gain, "bic_change": self.bic_change}
+
+
+@dataclass(frozen=True)
+class Verdict:
+    """Whether the final model explains the data: its residual over the measurement noise
+    (``ratio``, explained when at most :data:`~estimate.diagnosis.evidence.NOISE_MARGIN`),
+    and when it does not, where the residual concentrates and the best candidates that
+    were rejected, in one sentence."""
+
+    explained: bool
+    ratio: float
+    text: str
+    concentrated: tuple[str, ...] = ()
+    rejected: tuple[str, ...] = ()
+
+    @classmethod
+    def of(cls, evidence: Evidence, rounds: tuple[tuple[CandidateOutcome, ...], ...],
+           findings: tuple[Finding, ...]) -> "Verdict":
+        ratio = evidence.noise_ratio if math.isfinite(evidence.noise_ratio) else \
+            evidence.rms_residual / max(evidence.noise_rms, 1e-300)
+        if evidence.within_noise:
+            model = "The extended analog" if findings else "The baseline analog"
+            return cls(True, ratio, f"{model} explains the data: the residual is {ratio:.2f} "
+                                    f"times the measurement noise (within {NOISE_MARGIN:.2f}).")
+        where = [f"{f:.3g} Hz" for f in evidence.residual_frequencies]
+        tried = [o for rnd in rounds for o in rnd if o.rejected is not None
+                 and not o.rejected.startswith("not tried")]
+        tried.sort(key=lambda o: -(o.gain if math.isfinite(o.gain) else -1.0))
+        rejected = tuple(f"{o.cause} ({o.rejected})" for o in tried[:3])
+        text = (f"Unexplained: the residual is {ratio:.2f} times the measurement noise "
+                f"(more than {NOISE_MARGIN:.2f})"
+                + (f", concentrated at {', '.join(where)}" if where else "")
+                + ("; best rejected candidates: " + "; ".join(rejected) if rejected
+                   else "; no candidate family or library term fits it")
+                + ". Something the analog families do not describe is in the data.")
+        return cls(False, ratio, text, tuple(where), rejected)
+
+
+@dataclass(frozen=True)
+class Diagnosis:
+    """The outcome of :func:`estimate.diagnose`."""
+
+    baseline: FitResult
+    baseline_evidence: Evidence
+    findings: tuple[Finding, ...]
+    final: FitResult
+    final_evidence: Evidence
+    rounds: tuple[tuple[CandidateOutcome, ...], ...]
+    candidate_fits: int
+    seconds: float
+    notes: tuple[str, ...] = ()
+    verdict: Verdict | None = None
+
+    @property
+    def unexplained(self) -> bool:
+        """The final residual stays above the noise (see :class:`Verdict`)."""
+        return self.verdict is not None and not self.verdict.explained
+
+    def to_dict(self) -> dict[str, Any]:
+        """The fixed-key JSON form written by ``slosh diagnose``."""
+        base = self.baseline.to_dict()
+        fin = self.final.to_dict()
+        return {
+            "baseline": {"model": base["model"], "rms_residual": self.baseline.rms_residual,
+                         "parameters": base["parameters"]},
+            "findings": [f.to_dict() for f in self.findings],
+            "unexplained": self.unexplained,
+            "verdict": None if self.verdict is None else {
+                "explained": self.verdict.explained, "noise_ratio": self.verdict.ratio,
+                "text": self.verdict.text, "concentrated": list(self.verdict.concentrated),
+                "rejected": list(self.verdict.rejected)},
+            "final": {"model": fin["model"], "parameters": fin["parameters"],
+                      "derived": fin["derived"], "rms_residual": self.final.rms_residual,
+                      "measurement": _measurement_dict(self.final)},
+            "evidence": _evidence_dict(self.baseline_evidence),
+            "candidates": [[{"cause": c.cause, "added": list(c.added), "gain": c.gain,
+                             "bic_change": c.bic_change, "rms_before": c.rms_before,
+                             "rms_after": c.rms_after, "rejected": c.rejected,
+                             "score": c.score, "heldout_chi2_reduction": c.heldout_chi2}
+                            for c in rnd] for rnd in self.rounds],
+            "candidate_fits": self.candidate_fits,
+            "seconds": self.seconds,
+            "notes": list(self.notes),
+        }
+
+
+def _measurement_dict(res: FitResult) -> dict[str, Any]:
+    out: dict[str, Any] = {}
+    for mm in res.problem.measurement:
+        if isinstance(mm, SensorDelay):
+            out["sensor_delay_s"] = mm.delay
+    for name in ("rig.force_offset", "rig.force_drift", "rig.friction_viscous",
+                 "rig.friction_coulomb"):
+        if name in res.names:
+            out[name] = res.value(name)
+    return out
+
+
+def _evidence_dict(ev: Evidence) -> dict[str, Any]:
+    trends = {t.quantity: {"amplitudes_rad": list(t.amplitudes), "values": list(t.values),
+                           "slope": t.slope, "slope_stderr": t.slope_se, "text": t.text()}
+              for t in (ev.damping_trend, ev.frequency_trend) if t is not None}
+    return {
+        "rms_residual": ev.rms_residual, "noise_rms": ev.noise_rms,
+        "noise_ratio": ev.noise_ratio, "within_noise": ev.within_noise,
+        "drive_frequency_hz": ev.drive_frequency, "sweep": ev.sweep,
+        "residual_peaks": [{"frequency_hz": p.frequency, "amplitude": p.amplitude,
+                            "coherence": p.coherence, "drive_harmonic": p.harmonic}
+                           for p in ev.peaks],
+        "drive_harmonics": {str(k): v for k, v in ev.harmonics.items()},
+        "ljung_box": {"q": ev.ljung_box_q, "p_value": ev.ljung_box_p},
+        "timing_skew": {"correlation": ev.skew_correlation, "implied_delay_s": ev.skew_delay},
+        "frequency_vs_prediction": ev.frequency_ratio,
+        "pinned": list(ev.pinned),
+        "segments": [{"start_s": s.start, "stop_s": s.stop, "rms_angle": s.rms_angle,
+                      "damping_ratio": s.damping_ratio, "damping_ratio_stderr": s.damping_se,
+                      "frequency_hz": s.frequency_hz, "frequency_stderr": s.frequency_se}
+                     for s in ev.segments],
+        "amplitude_trends": trends,
+    }
