@@ -51,7 +51,9 @@ turning with the tank).
 
 Noise: white Gaussian, per channel, of standard deviation ``noise`` times the standard
 deviation of the noise-free channel about its mean, plus an optional tone (a motor line) of
-``tone[0]`` times that standard deviation at ``tone[1]`` Hz. The rig angles (``angles``:
+``tone[0]`` times that standard deviation at ``tone[1]`` Hz, plus an optional transducer
+drift: an offset that grows linearly from 0 to ``drift`` times that standard deviation
+over the record (its sign drawn per channel). The rig angles (``angles``:
 ``spin_angle``, ``nutation_phase``, ``cone_angle``) are returned as a test records them,
 with white noise of ``angle_noise`` rad.
 
@@ -299,7 +301,7 @@ def simulate_spinning(t, rig: Rig, *, pendulum: SphericalPendulum | None = None,
                       rotor: Rotor | None = None, oscillator: RotaryOscillator | None = None,
                       fixed_mass: float = 0.0, fixed_height: float = 0.0, x0=None,
                       steady: bool = False, noise: float = 0.0, tone=None,
-                      angle_noise: float = 0.0, seed: int = 0, rtol: float = 1e-11,
+                      drift: float = 0.0, angle_noise: float = 0.0, seed: int = 0, rtol: float = 1e-11,
                       atol: float = 1e-13) -> dict[str, np.ndarray]:
     """Six-axis outputs on the grid ``t`` (s), from rest in the tank unless ``steady``
     (:func:`steady_state` at ``t[0]``) or ``x0`` gives ``(alpha, beta, alpha_dot,
@@ -357,6 +359,9 @@ def simulate_spinning(t, rig: Rig, *, pendulum: SphericalPendulum | None = None,
         if tone is not None:
             out[name] = out[name] + tone[0] * scale * np.sin(2 * np.pi * tone[1] * t
                                                              + rng.uniform(0, 2 * np.pi))
+        if drift:
+            ramp = (t - t[0]) / (t[-1] - t[0])
+            out[name] = out[name] + rng.choice((-1.0, 1.0)) * drift * scale * ramp
     names = ("spin_angle", "nutation_phase", "cone_angle")
     out["angles"] = {k: v[0] + angle_noise * rng.standard_normal(t.size)
                      for k, v in zip(names, rig.angles(t))}
