@@ -18,6 +18,7 @@ from .mounted import Mounted
 from .parameter import Param, Parameter
 from .pendulum import Pendulum, SphericalPendulum
 from .rigs import LateralRig, crank_displacement
+from .rotary import RotaryOscillator, ThreeDofPendulum
 from .rotor import Rotor
 from .spacecraft import FreeSpacecraft, body_angular_velocity
 from .spinning import SpinningRig
@@ -45,10 +46,12 @@ __all__ = [
     "Pendulum",
     "QuadraticDamper",
     "Rig",
+    "RotaryOscillator",
     "Rotor",
     "SphericalPendulum",
     "SpinningRig",
     "SuspendedMass",
+    "ThreeDofPendulum",
     "UnknownNameError",
     "VehicleFrame",
     "body_angular_velocity",

@@ -12,29 +12,44 @@ from .parameter import Param
 if TYPE_CHECKING:  # pragma: no cover
     from .declaration import FrameDeclaration
 
-__all__ = ["SpinningRig", "TANK_AXES"]
+__all__ = ["SpinningRig", "TANK_AXES", "MOTIONS", "MOTION_INPUTS"]
 
 #: Orientations of the tank axis on a spinning table (see :class:`SpinningRig`).
 TANK_AXES = ("spin", "inward")
+#: How the rig motion is given (see :class:`SpinningRig`).
+MOTIONS = ("constant", "input")
+#: The rig's input signals with ``motion="input"`` (each with ``_dot`` and ``_ddot``), in
+#: the order the derived model lists them: the table's spin angle, the nutation (precession)
+#: phase of the table axis about the vertical and the cone half-angle, all in rad.
+MOTION_INPUTS = ("spin_angle", "nutation_phase", "cone_angle")
 
 
 class SpinningRig(Rig):
     """Spinning Slosh Test Rig: spin about the table axis plus an independent nutation.
 
-    The motion of the tank frame is prescribed analytically in time (the rig takes no
-    input signals), as a 3-1-3 rotation from the inertial frame ``N`` (``N.z`` up, the
-    table axis at rest):
+    The motion of the tank frame is a 3-1-3 rotation from the inertial frame ``N``
+    (``N.z`` up, the table axis at rest) by three angles, the nutation phase ``phi(t)``,
+    the cone half-angle ``theta_n(t)`` and the table's spin angle ``sigma(t)``:
 
-    1. the nutation frame ``C`` turns about ``N.z`` by ``phi(t) = 2 pi f_n t``;
+    1. the nutation frame ``C`` turns about ``N.z`` by ``phi``;
     2. the table frame ``D`` is ``C`` tilted about ``C.x`` by the cone half-angle
        ``theta_n``: the table (spin) axis ``D.z`` sweeps a cone of half-angle ``theta_n``
-       about ``N.z`` at ``f_n`` Hz (positive: in the sense of the spin), with its vertex at
-       the inertial origin (the nutation pivot);
-    3. the spin frame ``S`` turns about ``D.z`` by ``Omega_s t - phi(t)``, so that without
-       nutation (``theta_n = 0``) the table spins at exactly ``Omega_s`` about ``N.z``
-       whatever ``f_n``; its angular velocity is ``2 pi f_n N.z + (Omega_s - 2 pi f_n) D.z``.
-       Seen from the spinning table, the tilt of the table axis turns backwards at
-       ``Omega_s - 2 pi f_n`` rad/s.
+       about ``N.z`` at ``phi' / 2 pi`` Hz (positive: in the sense of the spin), with its
+       vertex at the inertial origin (the nutation pivot);
+    3. the spin frame ``S`` turns about ``D.z`` by ``sigma - phi``, so that without
+       nutation (``theta_n = 0``) the table has turned by exactly ``sigma`` about ``N.z``
+       whatever ``phi``; its angular velocity is ``phi' N.z + theta_n' C.x + (sigma' -
+       phi') D.z``. Seen from the spinning table, the tilt of the table axis turns
+       backwards at ``sigma' - phi'`` rad/s.
+
+    ``motion="constant"`` (default): ``sigma = Omega_s t``, ``phi = 2 pi f_n t`` and a
+    constant ``theta_n``, all parameters (the rig takes no input signals).
+    ``motion="input"``: the three angles are input signals ``rig.spin_angle``,
+    ``rig.nutation_phase`` and ``rig.cone_angle`` (rad), each with its first and second
+    time derivatives (``_dot``, ``_ddot``; :data:`MOTION_INPUTS`), as a test records them
+    (a table spun up, a cone angle ramped in) or as a schedule
+    (:class:`derive.schedule.Schedule`) gives them; the parameters ``spin_rate``,
+    ``nutation_angle`` and ``nutation_frequency`` are then absent.
 
     The tank origin ``O`` (the transducer's mount point and torque reference) sits at
     ``O = height D.z + radius S.x``: ``radius`` (m) from the spin axis along the radial
@@ -60,7 +75,8 @@ class SpinningRig(Rig):
     Parameters (``rig.``): ``spin_rate`` (rad/s), ``radius`` (m, default 0),
     ``height`` (m, default 0), ``nutation_angle`` (rad, default 0, in [0, pi/2)),
     ``nutation_frequency`` (Hz, default 0, either sign), ``dry_mass`` (kg) and, with
-    gravity, ``gravity`` (m/s^2).
+    gravity, ``gravity`` (m/s^2); with ``motion="input"`` only ``dry_mass``, ``radius``,
+    ``height`` and ``gravity``.
 
     Examples
     --------
@@ -73,9 +89,12 @@ class SpinningRig(Rig):
 
     measured = ("force_x", "force_y", "force_z", "torque_x", "torque_y", "torque_z")
 
-    def __init__(self, *, gravity: bool = True, tank_axis: str = "spin", name: str = "rig",
-                 bounds: dict[str, tuple[float, float]] | None = None,
+    def __init__(self, *, gravity: bool = True, tank_axis: str = "spin", motion: str = "constant",
+                 name: str = "rig", bounds: dict[str, tuple[float, float]] | None = None,
                  **values: float | None) -> None:
+        if motion not in MOTIONS:
+            raise InputError(
+                f"SpinningRig motion must be one of {', '.join(map(repr, MOTIONS))}, got {motion!r}")
         if tank_axis not in TANK_AXES:
             raise InputError(
                 f"SpinningRig tank_axis must be one of {', '.join(map(repr, TANK_AXES))}, "
@@ -86,6 +105,7 @@ class SpinningRig(Rig):
                 f"{gravity!r}; give its value as a parameter, e.g. `{{'rig.gravity': 9.81}}`")
         self.with_gravity = gravity
         self.tank_axis = tank_axis
+        self.motion = motion
         params = {
             "dry_mass": Param("kg", None, 0.0,
                               description="dry mass moving with the tank, seen by the transducer"),
@@ -98,6 +118,9 @@ class SpinningRig(Rig):
                                         description="coning frequency of the table axis about "
                                                     "the vertical (positive: with the spin)"),
         }
+        if motion == "input":
+            for key in ("spin_rate", "nutation_angle", "nutation_frequency"):
+                del params[key]
         if gravity:
             params["gravity"] = Param("m/s^2", 9.80665, 0.0,
                                       description="gravity along -z of the inertial frame")
@@ -105,18 +128,22 @@ class SpinningRig(Rig):
         super().__init__(name, bounds=bounds, **values)
 
     def _extra_structure(self) -> str:
-        return f"{self.tank_axis};{'g' if self.with_gravity else 'no-g'}"
+        return f"{self.tank_axis};{'g' if self.with_gravity else 'no-g'};{self.motion}"
 
     def declare_frame(self, f: "FrameDeclaration") -> None:
         import sympy as sp
         from sympy.physics.mechanics import Vector
 
         N, T, p = f.inertial, f.tank, f.p
-        phi = 2 * sp.pi * p.nutation_frequency * f.t
+        if self.motion == "input":
+            sigma, phi, theta = (f.add_input(name, "rad") for name in MOTION_INPUTS)
+        else:
+            phi = 2 * sp.pi * p.nutation_frequency * f.t
+            sigma, theta = p.spin_rate * f.t, p.nutation_angle
         C, D, S = f.frame("nutation"), f.frame("table"), f.frame("spin")
         C.orient_axis(N, N.z, phi)
-        D.orient_axis(C, C.x, p.nutation_angle)
-        S.orient_axis(D, D.z, p.spin_rate * f.t - phi)
+        D.orient_axis(C, C.x, theta)
+        S.orient_axis(D, D.z, sigma - phi)
         if self.tank_axis == "spin":
             T.orient_axis(S, S.z, 0)
         else:

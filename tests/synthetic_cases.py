@@ -61,32 +61,48 @@ def pendulum(mass=1.30, length=0.0553, zeta=0.01, stiffness=0.0, quadratic_dampi
 
 
 def make_spinning_case(folder: Path, name: str, rig, *, pendulum=None, rotor=None,
-                       fixed_mass=0.0, fixed_height=0.0, noise=0.01, duration=20.0,
-                       rate=100.0, seed=0, tank_radius=0.2, fill=0.6,
-                       prediction: Prediction | None = None):
+                       oscillator=None, fixed_mass=0.0, fixed_height=0.0, noise=0.01,
+                       tone=None, drift=0.0, duration=20.0, rate=100.0, seed=0, tank_radius=0.2, fill=0.6,
+                       prediction: Prediction | None = None, steady: bool = False,
+                       measured_angles: bool = False, angle_noise: float = 0.0):
     """Simulate with ``reference_spinning.simulate_spinning`` (six channels) and write
-    ``name.toml``/``.csv`` for ``rig = "spinning"``. ``rig`` is a ``reference_spinning.Rig``.
-    Returns ``(case, simulation dict)``."""
+    ``name.toml``/``.csv`` for ``rig = "spinning"``. ``rig`` is a ``reference_spinning.Rig``;
+    its spin-up and cone ramp become ``[rig.spin]`` schedules, or, with ``measured_angles``,
+    CSV columns ``table_angle``, ``precession`` and ``cone`` (with ``angle_noise`` rad of
+    noise) named by ``[rig.spin]``. ``steady``: the analog starts at its relative
+    equilibrium (``[test] initial_state = "steady"``). Returns ``(case, simulation dict)``."""
     import reference_spinning as rs
 
     from estimate.data.case import Spin
 
     t = np.arange(int(round(duration * rate)) + 1) / rate
-    sim = rs.simulate_spinning(t, rig, pendulum=pendulum, rotor=rotor, fixed_mass=fixed_mass,
-                               fixed_height=fixed_height, noise=noise, seed=seed)
+    sim = rs.simulate_spinning(t, rig, pendulum=pendulum, rotor=rotor, oscillator=oscillator,
+                               fixed_mass=fixed_mass, fixed_height=fixed_height, noise=noise,
+                               tone=tone, drift=drift, seed=seed, steady=steady, angle_noise=angle_noise)
     gravity_on = rig.gravity > 0
+    channels = {c: sim[c] for c in rs.CHANNELS}
+    motion: dict = {}
+    if measured_angles:
+        names = {"spin_angle": "table_angle", "nutation_phase": "precession",
+                 "cone_angle": "cone"}
+        channels |= {col: sim["angles"][key] for key, col in names.items()}
+        motion = dict(names)
+    else:
+        motion = {"spin_up": rig.spin_up, "nutation_ramp": rig.nutation_ramp,
+                  "nutation_start": rig.nutation_start if rig.nutation_ramp else None}
     case = write_case(
         Path(folder) / f"{name}.toml",
         test=TestInfo(id=name, rig="spinning", data=f"{name}.csv", excitation="spin",
-                      note="SYNTHETIC test data from tests/reference_spinning.py"),
+                      note="SYNTHETIC test data from tests/reference_spinning.py",
+                      initial_state="steady" if steady else None),
         tank=Tank(shape="sphere", radius=tank_radius, fill_fraction=fill, diaphragm=False),
         liquid=Liquid(density=998.2, kinematic_viscosity=1.004e-6),
         rig=Rig(dry_mass=rig.dry_mass, gravity=rig.gravity if gravity_on else G,
                 spin=Spin(rate=rig.spin_rate, radius=rig.radius,
                           nutation_angle=rig.nutation_angle,
                           nutation_frequency=rig.nutation_frequency, height=rig.height,
-                          gravity_on=gravity_on)),
-        time=t, channels={c: sim[c] for c in rs.CHANNELS}, prediction=prediction,
+                          gravity_on=gravity_on, **motion)),
+        time=t, channels=channels, prediction=prediction,
         comment="SYNTHETIC test case (tests/synthetic_cases.py)", overwrite=True)
     return case, sim
 

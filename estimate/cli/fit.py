@@ -58,8 +58,8 @@ def run(args: argparse.Namespace) -> int:
         print(f"{'converged' if result.converged else 'NOT converged'} ({result.status}), "
               f"{result.iterations} iterations, {result.seconds:.2f} s, RMS residual "
               f"{result.rms_residual:.4g} N")
-        for n, v, se, u in zip(result.names, result.values, result.stderr, result.units):
-            print(f"  {n:30s} {v:.6g} +/- {se:.2g} {u}")
+        for i, (n, v, u) in enumerate(zip(result.names, result.values, result.units)):
+            print(f"  {n:30s} {v:.6g} {u} {result.uncertainty_text(i)}")
         for c in result.confounded():
             print(f"  note: {c}")
     for w in result.warnings:

@@ -14,11 +14,14 @@ def add_parser(sub: argparse._SubParsersAction) -> None:
     p = sub.add_parser(
         "simulate", help="simulate a model for a test case's excitation",
         description="Simulate the analog model for the excitation of CASE.toml and write "
-                    "time,force (N) to a CSV file.")
+                    "time and every channel the case measures to a CSV file: time,force (N) "
+                    "on the lateral rig, time,force_x,...,torque_z (N, N m) on the spinning "
+                    "rig. The analog starts as `[test] initial_state` says (a \"free\" start "
+                    "is read from a fit result given as --params).")
     p.add_argument("case", help="test case file (TOML)")
     p.add_argument("--params", required=True,
                    help="JSON parameter values: a flat map {\"p1.mass\": 1.3, ...} or a fit result")
-    p.add_argument("--out", required=True, help="output CSV (time,force)")
+    p.add_argument("--out", required=True, help="output CSV (time and the measured channels)")
     p.add_argument("--model", default=None,
                    help="model specification, e.g. 'fixed,p1,p2' (default: fixed,p1 with hinge "
                         "spring and damper)")
@@ -36,16 +39,19 @@ def run(args: argparse.Namespace) -> int:
     from ..data import load_case
     from ..data.experiment import experiment
     from ..data.models import BASELINE, model_from_spec
-    from ..fitting.params_io import read_params
+    from ..fitting.params_io import fitted_initial_state, read_params
 
     out = Path(args.out)
     refuse_existing([out], args.overwrite)
     case = load_case(args.case)
     params = read_params(args.params)
+    x0 = fitted_initial_state(args.params, case) if case.test.initial_state == "free" else None
     exp = experiment(case, model_from_spec(args.model or BASELINE, case))
     integrator = RK4() if args.integrator == "rk4" else Adaptive()
-    sim = exp.simulate(params, integrator=integrator)
-    columns = {"time": sim.time, "force": sim.output("force_x")}
+    sim = exp.simulate(params, integrator=integrator, x0=x0)
+    # every channel the case measures; the lateral force keeps its historical name
+    columns = {"time": sim.time, **({"force": sim.output("force_x")} if exp.channels == ("force_x",)
+                                    else {c: sim.output(c) for c in exp.channels})}
     np.savetxt(out, np.column_stack(list(columns.values())), delimiter=",",
                header=",".join(columns), comments="", fmt="%.12g")
     print(f"wrote {out} ({sim.time.size} samples, model {', '.join(exp.model.names)})")

@@ -8,8 +8,10 @@ from typing import Any
 
 from .case import (
     KNOWN_EXCITATIONS,
+    KNOWN_INITIAL_STATES,
     KNOWN_RIGS,
     KNOWN_SHAPES,
+    SPIN_COLUMN_KEYS,
     TANK_AXES,
     Crank,
     Liquid,
@@ -125,6 +127,8 @@ def _read_test(ck: Checker, doc: Mapping[str, Any]) -> TestInfo | None:
     note = ck.string(t, "test", "note", required=False)
     at_rest = ck.boolean(t, "test", "starts_at_rest") if "starts_at_rest" in t else None
     bad_rest = "starts_at_rest" in t and at_rest is None
+    initial = ck.string(t, "test", "initial_state", choices=KNOWN_INITIAL_STATES, required=False)
+    bad_rest = bad_rest or ("initial_state" in t and initial is None)
     if data is not None and not data.strip():
         ck.add("[test] data", 'expected a CSV path, found an empty string ""')
         data = None
@@ -133,7 +137,7 @@ def _read_test(ck: Checker, doc: Mapping[str, Any]) -> TestInfo | None:
     assert test_id is not None and rig is not None and data is not None
     assert excitation is not None
     return TestInfo(id=test_id, rig=rig, data=data, excitation=excitation, note=note,
-                    starts_at_rest=at_rest)
+                    starts_at_rest=at_rest, initial_state=initial)
 
 
 def _read_tank(ck: Checker, doc: Mapping[str, Any]) -> Tank | None:
@@ -207,12 +211,52 @@ def _read_spin(ck: Checker, doc: Mapping[str, Any], *, required: bool) -> tuple[
     height = ck.number(t, "rig.spin", "height", unit="m") if "height" in t else 0.0
     axis = ck.string(t, "rig.spin", "tank_axis", choices=TANK_AXES, required=False)
     gravity_on = ck.boolean(t, "rig.spin", "gravity_on") if "gravity_on" in t else True
-    if None in (rate, radius, angle, freq, height, gravity_on) or ("tank_axis" in t and axis is None):
+    motion, motion_ok = _read_spin_motion(ck, t)
+    if None in (rate, radius, angle, freq, height, gravity_on) or ("tank_axis" in t and axis is None) \
+            or not motion_ok:
         return True, None
     assert rate is not None and radius is not None and angle is not None and freq is not None
     assert height is not None and gravity_on is not None
     return True, Spin(rate=rate, radius=radius, nutation_angle=angle, nutation_frequency=freq,
-                      height=height, tank_axis=axis or "spin", gravity_on=gravity_on)
+                      height=height, tank_axis=axis or "spin", gravity_on=gravity_on, **motion)
+
+
+def _read_spin_motion(ck: Checker, t: Mapping[str, Any]) -> tuple[dict[str, Any], bool]:
+    """The measured-motion columns and schedules of ``[rig.spin]``: (values, all valid)."""
+    out: dict[str, Any] = {}
+    ok = True
+    for key in SPIN_COLUMN_KEYS:
+        if key not in t:
+            continue
+        value = t[key]
+        if not isinstance(value, str) or not value.strip():
+            found = f"{_type_name(value)} `{value!r}`" if not isinstance(value, str) \
+                else 'an empty string ""'
+            ck.add(f"[rig.spin] {key}", f"expected the name of a CSV column of measured rig "
+                   f'motion (e.g. `{key} = "table_angle"`), found {found}; the nominal motion '
+                   "is given by `rate`, `nutation_angle` and `nutation_frequency`")
+            ok = False
+        out[key] = value
+    for key in ("spin_up", "nutation_ramp", "nutation_start"):
+        if key in t:
+            out[key] = ck.number(t, "rig.spin", key, unit="s", nonnegative=True)
+            ok = ok and out[key] is not None
+    if "spin_angle" in t and "spin_rate" in t:
+        ck.add("[rig.spin] spin_rate", "give the measured spin angle (`spin_angle`) or rate "
+               "(`spin_rate`), not both")
+        ok = False
+    for column, schedule in (("spin_angle", "spin_up"), ("spin_rate", "spin_up"),
+                             ("cone_angle", "nutation_ramp"), ("cone_angle", "nutation_start")):
+        if column in t and schedule in t:
+            ck.add(f"[rig.spin] {schedule}", f"a schedule for a motion the CSV column "
+                   f"`{t[column]}` (`{column}`) already measures; remove one of them")
+            ok = False
+    if "nutation_start" in t and "nutation_ramp" not in t \
+            or out.get("nutation_start") and out.get("nutation_ramp") == 0:
+        ck.add("[rig.spin] nutation_start", "the coning can only start later with a ramp: give "
+               "`nutation_ramp` > 0 s (a jump of the cone angle is not a rig motion)")
+        ok = False
+    return out, ok
 
 
 def _read_rig(ck: Checker, doc: Mapping[str, Any], excitation: str | None,

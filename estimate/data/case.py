@@ -58,6 +58,29 @@ N m; tank-frame components, torques about the mount point), in any order after `
 extra columns (e.g. measured rig angles) are allowed, kept in :attr:`Case.channels` and
 checked like the others.
 
+With these numbers alone the table spins at ``rate`` and cones at ``nutation_angle`` from the
+first sample. A test as the SSTR runs it spins the table up and ramps the coning in; the rig
+motion then comes from the record or from a schedule (optional keys of ``[rig.spin]``; the
+numbers above stay the nominal, final values)::
+
+    spin_angle = "table_angle"   # CSV column: the table's spin angle (rad), or
+    spin_rate = "table_rate"     #   the table's spin rate (rad/s), integrated
+    nutation_phase = "precession"  # CSV column: phase of the coning about the vertical (rad)
+    cone_angle = "cone"          # CSV column: cone half-angle of the table axis (rad)
+    spin_up = 12.0               # s: the rate rises smoothly from 0 to `rate` from t[0]
+    nutation_ramp = 5.0          # s: the cone angle rises smoothly from 0 to `nutation_angle`
+    nutation_start = 12.0        # s after t[0] (default: the end of the spin-up)
+
+Measured angles are unwrapped, smoothed without phase lag and differentiated twice
+(:func:`estimate.data.spin.rig_angle_derivatives`: a smoothing spline chosen by
+cross-validation); a measured spin angle excludes ``spin_up`` and a measured cone angle
+``nutation_ramp``.
+
+``[test] initial_state`` says where the liquid starts: ``"rest"`` (default: at rest in the
+tank), ``"steady"`` (at the relative equilibrium of the analog under the rig motion at the
+first sample: the pendulum swung out on its cone, a rotor turning with the tank; the
+record starts once the liquid has settled) or ``"free"`` (estimated with the parameters).
+
 :func:`load_case` (:mod:`estimate.data.reader`) validates everything and raises one
 :class:`CaseError` listing every problem; input files are never modified. :func:`write_case`
 writes a case (TOML + CSV), e.g. for generated data, and refuses to overwrite existing files
@@ -87,6 +110,7 @@ from analogs.errors import InputError
 
 __all__ = [
     "KNOWN_EXCITATIONS",
+    "KNOWN_INITIAL_STATES",
     "KNOWN_RIGS",
     "KNOWN_SHAPES",
     "MIN_SAMPLES",
@@ -98,6 +122,7 @@ __all__ = [
     "Prediction",
     "Rig",
     "SPINNING_CHANNELS",
+    "SPIN_COLUMN_KEYS",
     "Spin",
     "Tank",
     "TestInfo",
@@ -113,6 +138,10 @@ SPINNING_CHANNELS: tuple[str, ...] = ("force_x", "force_y", "force_z",
 """Columns a spinning-rig CSV must have besides ``time`` (N and N m)."""
 TANK_AXES: tuple[str, ...] = ("spin", "inward")
 """Values accepted for ``[rig.spin] tank_axis``."""
+KNOWN_INITIAL_STATES: tuple[str, ...] = ("rest", "steady", "free")
+"""Values accepted for ``[test] initial_state``."""
+SPIN_COLUMN_KEYS: tuple[str, ...] = ("spin_angle", "spin_rate", "nutation_phase", "cone_angle")
+"""Keys of ``[rig.spin]`` that name CSV columns of measured rig motion."""
 KNOWN_SHAPES: tuple[str, ...] = ("sphere", "cylinder")
 """Values accepted for ``[tank] shape``."""
 MIN_SAMPLES: int = 50
@@ -164,6 +193,9 @@ class TestInfo:
     starts_at_rest : bool or None
         ``[test] starts_at_rest``: whether the tank and carriage are at rest at the first
         sample; ``None`` (absent) lets the estimation detect a quiet start.
+    initial_state : str or None
+        ``[test] initial_state``, one of :data:`KNOWN_INITIAL_STATES`: where the liquid
+        (the analog's coordinates) starts; ``None`` (absent) means ``"rest"``.
     """
 
     __test__ = False  # not a pytest test class despite the name
@@ -174,6 +206,7 @@ class TestInfo:
     excitation: str
     note: str | None = None
     starts_at_rest: bool | None = None
+    initial_state: str | None = None
 
 
 @dataclass(frozen=True)
@@ -257,6 +290,16 @@ class Spin:
         ``"spin"`` or ``"inward"`` (see :class:`analogs.SpinningRig`).
     gravity_on : bool, default True
         Whether gravity acts (``[rig] gravity`` gives its value).
+    spin_angle, spin_rate, nutation_phase, cone_angle : str or None
+        CSV columns of the measured rig motion: the table's spin angle [rad] or rate
+        [rad/s] (not both), the nutation phase [rad] and the cone half-angle [rad].
+    spin_up : float, default 0
+        Time over which the spin rate rises from 0 to ``rate`` from the first sample [s].
+    nutation_ramp : float, default 0
+        Time over which the cone angle rises from 0 to ``nutation_angle`` [s].
+    nutation_start : float or None
+        Start of the cone-angle ramp after the first sample [s]; ``None``: the end of the
+        spin-up.
     """
 
     rate: float
@@ -266,6 +309,31 @@ class Spin:
     height: float = 0.0
     tank_axis: str = "spin"
     gravity_on: bool = True
+    spin_angle: str | None = None
+    spin_rate: str | None = None
+    nutation_phase: str | None = None
+    cone_angle: str | None = None
+    spin_up: float = 0.0
+    nutation_ramp: float = 0.0
+    nutation_start: float | None = None
+
+    @property
+    def columns(self) -> dict[str, str]:
+        """CSV columns of measured rig motion by key (``{"spin_angle": "table_angle"}``)."""
+        return {k: getattr(self, k) for k in SPIN_COLUMN_KEYS if getattr(self, k) is not None}
+
+    @property
+    def motion(self) -> str:
+        """``"constant"`` (rates and cone angle from the first sample, as parameters) or
+        ``"input"`` (measured columns or schedules drive the rig's input signals); see
+        :class:`analogs.SpinningRig`."""
+        scheduled = self.spin_up > 0 or self.nutation_ramp > 0 or bool(self.nutation_start)
+        return "input" if self.columns or scheduled else "constant"
+
+    @property
+    def ramp_start(self) -> float:
+        """Start of the cone-angle ramp after the first sample [s]."""
+        return self.spin_up if self.nutation_start is None else self.nutation_start
 
 
 @dataclass(frozen=True)

@@ -31,10 +31,40 @@ class Experiment:
     excitation: Excitation | None
     fixed: Mapping[str, float]
 
-    def simulate(self, params: Mapping[str, float], **options) -> Simulation:
-        """Simulate on the case's time grid; ``params`` over the case's rig values."""
+    def simulate(self, params: Mapping[str, float], *, x0: Mapping[str, float] | None = None,
+                 **options) -> Simulation:
+        """Simulate on the case's time grid; ``params`` over the case's rig values, from the
+        case's initial state (:meth:`initial_state`) unless ``x0`` gives it."""
         values = {**self.fixed, **params}
-        return simulate(self.derived, values, self.case.time, self.excitation, **options)
+        if x0 is None:
+            x0 = self.initial_state(values)
+        return simulate(self.derived, values, self.case.time, self.excitation, x0=x0, **options)
+
+    @property
+    def initial_state_kind(self) -> str:
+        """``[test] initial_state`` of the case (``"rest"`` when absent)."""
+        return self.case.test.initial_state or "rest"
+
+    def initial_state(self, params: Mapping[str, float]) -> dict[str, float] | None:
+        """The state at the first sample for parameter values ``params``: ``None`` (rest)
+        for ``"rest"``; for ``"steady"`` the relative equilibrium of the analog under the rig
+        motion at the first sample (:func:`derive.equilibrium.relative_equilibrium`).
+        ``"free"`` states are estimated by a fit, not known here: raises."""
+        kind = self.initial_state_kind
+        if kind == "rest":
+            return None
+        if kind == "free":
+            raise InputError(f"{self.case.path}: [test] initial_state = \"free\" is estimated "
+                             "with the parameters; give the fitted initial state (a fit "
+                             "result's `initial_states`) to simulate this case")
+        from derive.equilibrium import relative_equilibrium
+
+        dm = self.derived
+        t = np.asarray(self.case.time[:2], float)
+        u = (self.excitation.values(t) if self.excitation is not None and dm.nu
+             else np.zeros((dm.nu, 2)))
+        x = relative_equilibrium(dm, dm.parameter_vector({**self.fixed, **params}), t, u)
+        return dict(zip(dm.states, map(float, x)))
 
     @property
     def measured(self) -> np.ndarray:
@@ -54,8 +84,9 @@ def experiment(case: Case, model: Model) -> Experiment:
 
     A measured displacement becomes a zero-phase smoothed displacement, velocity and
     acceleration (:func:`estimate.data.signals.displacement_derivatives`) interpolated by
-    cubic B-splines; a crank drive and the spinning rig (whose motion is an explicit function
-    of time) need no input signal.
+    cubic B-splines; a spinning rig spun up or coned in drives its input signals from the
+    measured rig angles or schedules (:func:`estimate.data.spin.spin_excitation`); a crank
+    drive and a spinning rig at constant rates (explicit functions of time) need none.
     """
     dm = derive(model)
     if case.test.rig == "lateral" and case.test.excitation == "measured":
@@ -63,6 +94,10 @@ def experiment(case: Case, model: Model) -> Experiment:
             raise InputError(f"{case.path}: excitation = 'measured' needs a displacement column")
         x, xd, xdd = displacement_derivatives(case.time, case.displacement)
         exc: Excitation | None = Sampled(case.time, np.vstack([x, xd, xdd]))
+    elif case.spin is not None and case.spin.motion == "input":
+        from .spin import spin_excitation
+
+        exc = spin_excitation(case)
     else:
         exc = None
     return Experiment(case, model, dm, exc, rig_values(case))

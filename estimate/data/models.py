@@ -47,7 +47,7 @@ def rig_for(case: Case) -> Rig:
         spin = case.rig.spin
         if spin is None:
             raise InputError(f"{case.path}: `rig = \"spinning\"` needs a `[rig.spin]` table")
-        return SpinningRig(gravity=spin.gravity_on, tank_axis=spin.tank_axis)
+        return SpinningRig(gravity=spin.gravity_on, tank_axis=spin.tank_axis, motion=spin.motion)
     if case.test.rig != "lateral":
         raise InputError(f"{case.path}: [test] rig = {case.test.rig!r} is not supported; "
                          "expected 'lateral' or 'spinning'")
@@ -56,8 +56,17 @@ def rig_for(case: Case) -> Rig:
 
 def model_for_case(model: Model, case: Case) -> Model:
     """``model`` on the rig ``case`` needs: a lateral model built for a measured case drives
-    a crank case through its crank (and the other way round); other rigs are kept."""
+    a crank case through its crank (and the other way round); a spinning-rig model takes
+    the rig motion the case gives (constant rates or input signals); other rigs are kept."""
     rig = model.rig
+    spin = case.rig.spin
+    if isinstance(rig, SpinningRig) and spin is not None and rig.motion != spin.motion:
+        keep = {k: v for k, v in rig._values.items() if k in ("dry_mass", "radius", "height",
+                                                                "gravity")}
+        return model.replace(SpinningRig(gravity=rig.with_gravity, tank_axis=rig.tank_axis,
+                                         motion=spin.motion, name=rig.name,
+                                         bounds={k: v for k, v in rig._bounds.items() if k in keep},
+                                         **keep))
     if isinstance(rig, LateralRig) and case.test.rig == "lateral" \
             and rig.excitation != case.test.excitation:
         shared = {"dry_mass", "gravity"}  # what both excitations of the rig have
@@ -70,14 +79,16 @@ def model_for_case(model: Model, case: Case) -> Model:
 
 def rig_values(case: Case) -> dict[str, float]:
     """Parameter values the case file fixes: dry mass, gravity and the crank geometry, or
-    the spinning rig's motion (``[rig.spin]`` -> ``rig.spin_rate``, ``rig.radius``,
-    ``rig.height``, ``rig.nutation_angle``, ``rig.nutation_frequency``)."""
+    the spinning rig's geometry and constant motion (``[rig.spin]`` -> ``rig.radius``,
+    ``rig.height`` and, without measured motion or schedules, ``rig.spin_rate``,
+    ``rig.nutation_angle``, ``rig.nutation_frequency``)."""
     spin = case.rig.spin
     if case.test.rig == "spinning" and spin is not None:
-        out = {"rig.dry_mass": case.rig.dry_mass, "rig.spin_rate": spin.rate,
-               "rig.radius": spin.radius, "rig.height": spin.height,
-               "rig.nutation_angle": spin.nutation_angle,
-               "rig.nutation_frequency": spin.nutation_frequency}
+        out = {"rig.dry_mass": case.rig.dry_mass, "rig.radius": spin.radius,
+               "rig.height": spin.height}
+        if spin.motion == "constant":  # else the rig motion is the rig's input signals
+            out |= {"rig.spin_rate": spin.rate, "rig.nutation_angle": spin.nutation_angle,
+                    "rig.nutation_frequency": spin.nutation_frequency}
         if spin.gravity_on:
             out["rig.gravity"] = case.rig.gravity
         return out

@@ -77,6 +77,10 @@ def load_case(path: str | os.PathLike[str]) -> Case:
             csv_problems: list[str] = []
             arrays = read_csv(data_path, excitation, csv_problems, rig_kind)
             problems.extend(csv_problems)
+            if arrays is not None and rig is not None:
+                from .spin import spin_column_problems
+
+                problems.extend(spin_column_problems(fname, rig.spin, arrays[3], arrays[0]))
 
     if problems:
         raise CaseError(problems)

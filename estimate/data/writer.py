@@ -60,6 +60,8 @@ def _toml_text(test: TestInfo, tank: Tank, liquid: Liquid, rig: Rig,
         rows.append(("note", test.note, ""))
     if test.starts_at_rest is not None:
         rows.append(("starts_at_rest", test.starts_at_rest, "tank and carriage at rest at t[0]"))
+    if test.initial_state is not None:
+        rows.append(("initial_state", test.initial_state, "the liquid at t[0]"))
     table("test", rows)
     table("tank", [("shape", tank.shape, ""), ("radius", tank.radius, "m"),
                    ("fill_fraction", tank.fill_fraction, "liquid depth / tank height"),
@@ -76,7 +78,7 @@ def _toml_text(test: TestInfo, tank: Tank, liquid: Liquid, rig: Rig,
                            ("nutation_frequency", sp.nutation_frequency, "Hz, coning frequency"),
                            ("height", sp.height, "m, tank origin above the nutation pivot"),
                            ("tank_axis", sp.tank_axis, ""),
-                           ("gravity_on", sp.gravity_on, "")])
+                           ("gravity_on", sp.gravity_on, "")] + _spin_motion_rows(sp))
     if rig.crank is not None:
         table("rig.crank", [("radius", rig.crank.radius, "m"),
                             ("rod_length", rig.crank.rod_length, "m"),
@@ -87,6 +89,20 @@ def _toml_text(test: TestInfo, tank: Tank, liquid: Liquid, rig: Rig,
                              ("fixed_mass", prediction.fixed_mass, "kg"),
                              ("damping_ratio", prediction.damping_ratio, "fraction of critical")])
     return "\n".join(out).rstrip("\n") + "\n"
+
+
+def _spin_motion_rows(spin) -> list[tuple[str, Any, str]]:
+    """The measured-motion columns and schedules of ``[rig.spin]`` that are set."""
+    notes = {"spin_angle": "CSV column, rad", "spin_rate": "CSV column, rad/s",
+             "nutation_phase": "CSV column, rad", "cone_angle": "CSV column, rad"}
+    rows: list[tuple[str, Any, str]] = [(k, v, notes[k]) for k, v in spin.columns.items()]
+    if spin.spin_up:
+        rows.append(("spin_up", spin.spin_up, "s, spin-up from rest"))
+    if spin.nutation_ramp:
+        rows.append(("nutation_ramp", spin.nutation_ramp, "s, cone-angle ramp"))
+    if spin.nutation_start is not None:
+        rows.append(("nutation_start", spin.nutation_start, "s after t[0]"))
+    return rows
 
 
 def _csv_text(time: NDArray[np.float64], displacement: NDArray[np.float64] | None,

@@ -26,11 +26,14 @@ def _pyplot():
 
 def _parameter_rows(res: FitResult) -> list[str]:
     rows = ["| parameter | estimate | std. error | 95 % interval | unit |", "|---|---|---|---|---|"]
-    for name, v, se, e in zip(res.names, res.values, res.stderr, res.problem.estimated):
+    for i, (name, v, se, e) in enumerate(zip(res.names, res.values, res.stderr,
+                                             res.problem.estimated)):
         lo, hi = res.interval(name)
-        rows.append(f"| `{name}` | {v:.5g} | {se:.2g} | [{lo:.5g}, {hi:.5g}] | {e.unit} |")
+        se_text = f"{se:.2g}" if res.free[i] else res.uncertainty_text(i)
+        rows.append(f"| `{name}` | {v:.5g} | {se_text} | [{lo:.5g}, {hi:.5g}] | {e.unit} |")
     for k, (v, se) in res.derived.items():
-        rows.append(f"| `{k}` (derived) | {v:.5g} | {se:.2g} | | |")
+        rows.append(f"| `{k}` (derived) | {v:.5g} | {se:.2g} | | |" if se == se
+                    else f"| `{k}` (derived) | {v:.5g} | at a bound | | |")
     return rows
 
 

@@ -48,7 +48,15 @@ def reduced_jacobian(jac_residuals: sps.spmatrix, jac_constraints: sps.spmatrix,
 @dataclass(frozen=True)
 class Uncertainty:
     """Covariance of the estimates (their units squared), standard errors, correlations,
-    the residual variance ``sigma2`` and the identifiability analysis."""
+    the residual variance ``sigma2`` and the identifiability analysis.
+
+    Parameters held at an active bound (``held`` of :func:`uncertainty`) have no Wald
+    standard error: their rows and columns of ``covariance`` are zero (they stay at the
+    bound), their ``stderr`` and correlations are NaN and they are left out of the
+    identifiability analysis; ``bound_stderr`` gives, for them only, the standard deviation
+    of the estimate the data would allow if the bound were lifted (the others re-estimated),
+    NaN when the data do not determine it.
+    """
 
     covariance: np.ndarray
     stderr: np.ndarray
@@ -56,29 +64,58 @@ class Uncertainty:
     sigma2: float
     identifiability: Identifiability
     warnings: tuple[str, ...]
+    bound_stderr: np.ndarray | None = None
 
 
 def uncertainty(jac_residuals: sps.spmatrix, jac_constraints: sps.spmatrix,
                 residuals: np.ndarray, n_observations: int, ntheta: int, scales: np.ndarray,
-                names: tuple[str, ...]) -> Uncertainty:
+                names: tuple[str, ...], held: tuple[int, ...] = ()) -> Uncertainty:
     """The Gauss-Newton covariance of the first ``ntheta`` decision variables (scaled by
-    ``scales``) from the sparse residual and constraint Jacobians at the optimum."""
+    ``scales``) from the sparse residual and constraint Jacobians at the optimum; the
+    parameters ``held`` (indices, at an active bound) are held there (see
+    :class:`Uncertainty`)."""
     Je = sps.csc_matrix(jac_residuals)
     Jg = sps.csc_matrix(jac_constraints)
     nw, ng = Je.shape[1], Jg.shape[0]
     k = nw - ng  # estimated quantities: variables the constraints leave free
     sigma2 = float(residuals @ residuals) / max(n_observations - k, 1)
-    kkt = ReducedKKT(Je, Jg, ntheta)
+    S = parameter_information(Je, Jg, ntheta)
+    free = np.setdiff1d(np.arange(ntheta), np.asarray(held, int))
+    # a prior of relative standard deviation 1e3 on every (scaled) parameter: nothing for
+    # what the data determine, a huge finite variance for a direction they do not
+    X, singular = _inverse(S[np.ix_(free, free)])
     warnings = []
-    if kkt.singular:
+    if singular:
         warnings.append("the residual sensitivity is singular: the data do not determine some "
                         "directions of the parameters (see the identifiability check)")
-    cov = sigma2 * kkt.inverse_information * np.outer(scales, scales)
-    d = np.sqrt(np.clip(np.diag(cov), 0, None))
+    cov = np.zeros((ntheta, ntheta))
+    cov[np.ix_(free, free)] = sigma2 * X * np.outer(scales[free], scales[free])
+    d = np.full(ntheta, np.nan)
+    d[free] = np.sqrt(np.clip(np.diag(cov)[free], 0, None))
+    corr = np.full((ntheta, ntheta), np.nan)
     with np.errstate(invalid="ignore", divide="ignore"):
-        corr = np.clip(np.nan_to_num(cov / np.outer(d, d)), -1.0, 1.0)
-    ident = analyse(cov, scales, names, corr)
-    return Uncertainty(cov, d, corr, sigma2, ident, tuple(warnings))
+        sub = cov[np.ix_(free, free)] / np.outer(d[free], d[free])
+    corr[np.ix_(free, free)] = np.clip(np.nan_to_num(sub, nan=0.0, posinf=0.0, neginf=0.0),
+                                       -1.0, 1.0)
+    ident = analyse(cov[np.ix_(free, free)], scales[free], tuple(names[i] for i in free),
+                    corr[np.ix_(free, free)])
+    bound_se = np.full(ntheta, np.nan)
+    if len(free) < ntheta:
+        Xall, _ = _inverse(S)
+        for i in held:
+            if Xall[i, i] < 1 / (10 * _PRIOR_INFORMATION):  # determined by the data
+                bound_se[i] = np.sqrt(sigma2 * Xall[i, i]) * scales[i]
+    return Uncertainty(cov, d, corr, sigma2, ident, tuple(warnings), bound_se)
+
+
+def _inverse(S: np.ndarray) -> tuple[np.ndarray, bool]:
+    """Inverse of the (scaled) information with the prior floor, and whether it is
+    singular without it."""
+    if S.size == 0:
+        return np.zeros((0, 0)), False
+    lam, V = np.linalg.eigh(0.5 * (S + S.T))
+    singular = bool(lam.min() <= _PRIOR_INFORMATION * max(lam.max(), 1.0) * 1e-3)
+    return (V / np.maximum(lam, _PRIOR_INFORMATION)) @ V.T, singular
 
 
 #: Information floor of each scaled parameter's direction (relative variance 1e6 at most):

@@ -3,13 +3,15 @@
 from __future__ import annotations
 
 import math
-from collections.abc import Mapping
+from collections.abc import Iterable, Mapping
 
 from analogs import Model
+from analogs.errors import InputError
 
 from ..data.case import Case
 
-__all__ = ["predicted_values", "length_bounds", "nominal_scale", "LENGTH_BAND"]
+__all__ = ["predicted_values", "predicted_sources", "source_notes", "length_bounds",
+           "nominal_scale", "LENGTH_BAND"]
 
 #: Pendulum lengths are kept within +/-20 % of the prediction, as the seed did.
 LENGTH_BAND = 0.20
@@ -27,56 +29,129 @@ def _tank_prediction(case: Case, modes: int):
 
 
 def predicted_values(case: Case, model: Model) -> dict[str, float]:
-    """Predicted analog parameters for the components of ``model``.
+    """Predicted analog parameters for the components of ``model`` (see
+    :func:`predicted_sources`, which also says where each value comes from)."""
+    return predicted_sources(case, model)[0]
 
-    ``[prediction]`` of the case gives the first mode and the fixed mass; the tank modal
-    analysis (:mod:`analogs.tank`, exact potential flow) gives higher modes, hinge heights
-    and everything when the case has no ``[prediction]``. Hinge springs and extra dampers
-    start at zero; hinge dampers from the predicted damping ratio:
-    ``c = 2 zeta m L^2 omega`` with ``omega = sqrt(g / L)``.
+
+#: Where an initial value comes from (:func:`predicted_sources`).
+FROM_PREDICTION = "[prediction]"
+FROM_GUESS = "a guess"
+
+
+def predicted_sources(case: Case, model: Model, needed: Iterable[str] | None = None
+                      ) -> tuple[dict[str, float], dict[str, str], str | None]:
+    """Predicted analog parameters for the components of ``model``, where each comes from,
+    and why the tank modal analysis could not supply any (``None`` when it did or was not
+    needed).
+
+    ``[prediction]`` of the case gives the first mode (mass, length, damping ratio) and the
+    fixed mass; the tank modal analysis (:mod:`analogs.tank`, exact potential flow) gives
+    higher modes, hinge heights, the fixed mass's height and inertias, and everything when
+    the case has no ``[prediction]``. It runs when the case has no ``[prediction]``, when the
+    model has higher modes, or when a parameter in ``needed`` (default: every parameter of
+    the model) is not in ``[prediction]``. Hinge springs and extra dampers start at zero;
+    hinge dampers from the predicted damping ratio: ``c = 2 zeta m L^2 omega`` with
+    ``omega = sqrt(g / L)``. Rotors, rotary oscillators and the bob inertias of a 3-DOF
+    pendulum start from guesses (source :data:`FROM_GUESS`).
     """
     g = case.rig.gravity
     pendulums = [n for n in model.names if n.startswith("p") and n[1:].isdigit()]
     n_modes = max([int(n[1:]) for n in pendulums] or [1])
+    needed = set(p.name for p in model.parameters) if needed is None else set(needed)
     out: dict[str, float] = {}
-    # the modal analysis is needed for higher modes or when the case predicts nothing
-    if case.prediction is None or n_modes > 1:
-        pred = _tank_prediction(case, max(n_modes, 1))
-        modes = {f"p{i + 1}": m for i, m in enumerate(pred.modes)}
-        for name, mode in modes.items():
-            out |= {f"{name}.mass": mode.mass, f"{name}.length": mode.length,
-                    f"{name}.hinge_height": mode.hinge_height}
-            zeta = mode.damping_ratio if math.isfinite(mode.damping_ratio) else 0.01
-            out[f"{name}.zeta"] = zeta
-        out |= {"fixed.mass": pred.fixed_mass.mass, "fixed.height": pred.fixed_mass.height,
-                "fixed.inertia": pred.fixed_mass.inertia}
-    if case.prediction is not None:
-        pr = case.prediction
-        out |= {"p1.mass": pr.pendulum_mass, "p1.length": pr.pendulum_length,
-                "fixed.mass": pr.fixed_mass, "p1.zeta": pr.damping_ratio}
+    source: dict[str, str] = {}
+    pred = case.prediction
+    from_prediction = {} if pred is None else {
+        "p1.mass": pred.pendulum_mass, "p1.length": pred.pendulum_length,
+        "fixed.mass": pred.fixed_mass, "p1.zeta": pred.damping_ratio}
+    analysis_needed = pred is None or n_modes > 1 or any(
+        n not in from_prediction and _from_analysis(n) for n in needed)
+    failure = None
+    if analysis_needed:
+        try:
+            analysis = _tank_prediction(case, max(n_modes, 1))
+        except (InputError, ValueError, ArithmeticError) as err:
+            analysis, failure = None, f"the tank modal analysis failed: {err}"
+        if analysis is not None:
+            tank = case.tank
+            label = (f"the tank modal analysis ({tank.shape} R = {tank.radius:g} m, "
+                     f"{100 * tank.fill_fraction:g} % fill)")
+            for i, mode in enumerate(analysis.modes):
+                name = f"p{i + 1}"
+                zeta = mode.damping_ratio if math.isfinite(mode.damping_ratio) else 0.01
+                out |= {f"{name}.mass": mode.mass, f"{name}.length": mode.length,
+                        f"{name}.hinge_height": mode.hinge_height, f"{name}.zeta": zeta}
+            fm = analysis.fixed_mass
+            out |= {"fixed.mass": fm.mass, "fixed.height": fm.height, "fixed.inertia": fm.inertia,
+                    "fixed.axial_inertia": fm.inertia}
+            source |= dict.fromkeys(out, label)
+    out |= from_prediction
+    source |= dict.fromkeys(from_prediction, FROM_PREDICTION)
     for name in pendulums:
         if f"{name}.mass" not in out:
             continue
         m, L = out[f"{name}.mass"], out[f"{name}.length"]
         zeta = out.pop(f"{name}.zeta")
         out[f"{name}.damping"] = 2 * zeta * m * L**2 * math.sqrt(g / L)
-        out[f"{name}.stiffness"] = 0.0
-        out[f"{name}.quadratic_damping"] = 0.0
-        out[f"{name}.diaphragm_stiffness"] = 0.0
-        out[f"{name}.diaphragm_damping"] = 0.0
-    if "fixed.inertia" in out:
-        out.setdefault("fixed.axial_inertia", out["fixed.inertia"])
-    from analogs import Rotor
+        source[f"{name}.damping"] = source.pop(f"{name}.zeta")
+        for k in ("stiffness", "quadratic_damping", "diaphragm_stiffness", "diaphragm_damping",
+                  "twist_stiffness", "twist_damping"):
+            out[f"{name}.{k}"] = 0.0
+            source[f"{name}.{k}"] = "zero (no hinge element predicted)"
+    _guesses(case, model, out, source)
+    keep = {k: v for k, v in out.items() if not k.endswith(".zeta")}
+    return keep, {k: source[k] for k in keep}, failure
 
+
+def _from_analysis(name: str) -> bool:
+    """Whether the tank modal analysis supplies ``name`` (heights, inertias, modes)."""
+    comp, local = name.split(".", 1)
+    if comp == "fixed":
+        return local in ("mass", "height", "inertia", "axial_inertia")
+    return comp.startswith("p") and comp[1:].isdigit() and local in ("mass", "length",
+                                                                     "hinge_height")
+
+
+def _guesses(case: Case, model: Model, out: dict[str, float], source: dict[str, str]) -> None:
+    """Starting values nothing predicts: rotors, rotary oscillators, 3-DOF bob inertias."""
+    from analogs import RotaryOscillator, Rotor, ThreeDofPendulum
+
+    R = case.tank.radius
+    liquid = case.liquid.density * 4 / 3 * math.pi * R**3 * case.tank.fill_fraction
+    spin = abs(case.spin.rate) if case.spin is not None else 0.0
     for comp in model.components:
+        n = comp.name
         if isinstance(comp, Rotor):
-            # a guess, not a prediction: 5 % of the liquid's inertia about a diameter of a
-            # sphere of the tank radius, coupled with a 1 s time constant
-            R = case.tank.radius
-            liquid = case.liquid.density * 4 / 3 * math.pi * R**3 * case.tank.fill_fraction
-            out[f"{comp.name}.inertia"] = 0.05 * 0.4 * liquid * R**2
-            out[f"{comp.name}.damping"] = out[f"{comp.name}.inertia"] / 1.0
-    return {k: v for k, v in out.items() if not k.endswith(".zeta")}
+            # 5 % of the liquid's inertia about a diameter of a sphere of the tank radius,
+            # coupled with a 1 s time constant
+            out[f"{n}.inertia"] = 0.05 * 0.4 * liquid * R**2
+            out[f"{n}.damping"] = out[f"{n}.inertia"] / 1.0
+            source |= dict.fromkeys((f"{n}.inertia", f"{n}.damping"),
+                                    f"{FROM_GUESS} (5 % of the liquid's inertia, 1 s coupling)")
+        elif isinstance(comp, RotaryOscillator):
+            # the same inertia, a natural frequency above the spin rate (where it is stable
+            # with damping relative to the tank), 5 % of critical damping
+            J = 0.05 * 0.4 * liquid * R**2
+            w = max(1.5 * spin, 2 * math.pi)
+            out |= {f"{n}.inertia": J, f"{n}.stiffness": J * w**2, f"{n}.damping": 0.1 * J * w}
+            source |= dict.fromkeys((f"{n}.inertia", f"{n}.stiffness", f"{n}.damping"),
+                                    f"{FROM_GUESS} (natural frequency {w / (2 * math.pi):.3g} Hz)")
+        elif isinstance(comp, ThreeDofPendulum) and f"{n}.mass" in out:
+            bob = 0.1 * out[f"{n}.mass"] * out[f"{n}.length"] ** 2
+            out |= {f"{n}.inertia": bob, f"{n}.axial_inertia": bob}
+            source |= dict.fromkeys((f"{n}.inertia", f"{n}.axial_inertia"),
+                                    f"{FROM_GUESS} (10 % of m L^2)")
+
+
+def source_notes(sources: Mapping[str, str], names: Iterable[str]) -> list[str]:
+    """One note per source naming the estimated parameters ``names`` it started."""
+    by_source: dict[str, list[str]] = {}
+    for n in names:
+        if n in sources:
+            by_source.setdefault(sources[n], []).append(n)
+    return [f"initial values from {src}: {', '.join(f'`{n}`' for n in ns)}"
+            for src, ns in by_source.items()]
 
 
 def length_bounds(predicted_length: float) -> tuple[float, float]:

@@ -22,6 +22,7 @@ import scipy.sparse as sps
 
 from analogs.errors import InputError
 
+from ..data.case import KNOWN_INITIAL_STATES
 from ._progress import Recorder, progress_printer
 from .covariance import reduced_jacobian, uncertainty
 from .problem import FitProblem
@@ -59,7 +60,7 @@ class Hessian:
 
 
 def fit(problem: FitProblem, *, transcription: Transcription = MultipleShooting(),
-        hessian: Hessian = Hessian(), cost: str = "squared", initial_state: str = "rest",
+        hessian: Hessian = Hessian(), cost: str = "squared", initial_state: str | None = None,
         solver_options: Mapping[str, object] | None = None,
         progress: bool | None = None, robust_start: bool = True,
         compile_: bool | None = None, warm_start: FitResult | None = None) -> FitResult:
@@ -78,8 +79,13 @@ def fit(problem: FitProblem, *, transcription: Transcription = MultipleShooting(
         ``sum((|E| - |S|)^2)``, with a smooth absolute value (filtered input only).
         Residuals, RMS, R^2 and the covariance of the result are those of
         ``simulated - measured`` for either cost.
-    initial_state : {"rest", "free"}
-        Start every case at rest (the tests start from rest) or estimate the initial state.
+    initial_state : {"rest", "steady", "free"}, optional
+        Where the analog starts in every case: at rest; ``"steady"``, at the relative
+        equilibrium under the rig motion at the first sample (a pendulum on its cone on a
+        spinning table, a rotor turning with the tank), tied to the parameters by equality
+        constraints (:mod:`estimate.fitting.steady`); ``"free"``, estimated with the
+        parameters (and marginalised in the covariance). Default: each case's ``[test]
+        initial_state`` (``"rest"`` when absent).
     solver_options : mapping, optional
         Options passed to ``casadi.nlpsol`` (e.g. ``{"ipopt.max_iter": 500}``).
     progress : bool, optional
@@ -108,8 +114,10 @@ def fit(problem: FitProblem, *, transcription: Transcription = MultipleShooting(
         raise InputError("cost='abs' compares force magnitudes only, so it cannot tell the "
                          "carriage motion's sign: build the problem with input='filtered' "
                          "(`slosh fit --cost abs --input filtered`)")
-    if initial_state not in ("rest", "free"):
-        raise InputError(f"initial_state must be 'rest' or 'free', got {initial_state!r}")
+    if initial_state not in (None, *KNOWN_INITIAL_STATES):
+        raise InputError(f"initial_state must be one of {', '.join(map(repr, KNOWN_INITIAL_STATES))} "
+                         f"(or None: each case's `[test] initial_state`), got {initial_state!r}")
+    kinds = [initial_state or e.initial_state_kind for e in problem.experiments]
     if progress is None:
         progress = sys.stderr.isatty()
     t_start = time.perf_counter()
@@ -124,8 +132,7 @@ def fit(problem: FitProblem, *, transcription: Transcription = MultipleShooting(
     scales = np.array([e.scale for e in est])
     # the exact Hessian differentiates g twice: keep g an AD-able expression then
     blocks_ok = hessian.kind == "gauss-newton"
-    nlp, terms = _setup(problem, transcription, cost, initial_state, blocks_ok, compile_,
-                        warm_start)
+    nlp, terms = _setup(problem, transcription, cost, kinds, blocks_ok, compile_, warm_start)
     opts = dict(_IPOPT_DEFAULTS)
     opts.update(nlp.derivative_options(hessian, blocks_ok))
     recorder = Recorder(nlp.w.numel(), nlp.g.numel(), len(est), scales, 2 * nlp.norm,
@@ -152,14 +159,21 @@ def fit(problem: FitProblem, *, transcription: Transcription = MultipleShooting(
     states = tuple(np.asarray(out[4 + 2 * k + i]) for i in range(k))
     coefs = tuple(np.asarray(out[4 + 3 * k + i]).ravel() if terms[i].coef.numel() else None
                   for i in range(k))
+    starts = ca.Function("starts", [nlp.w], [t.block.X[:, 0] for t in terms])(w_opt)
+    starts = (starts,) if k == 1 else tuple(starts)
+    initial_states = tuple(
+        dict(zip(e.derived.states, np.asarray(x, float).ravel().tolist()))
+        for e, x in zip(problem.experiments, starts))
     return _result(problem, theta, solver.stats(), recorder, terms,
                    *(np.asarray(out[j]).ravel() for j in (0, 2, 3)), J, Je, Jg, t_start,
-                   transcription, cost, carriage, xres, states, coefs)
+                   transcription, cost, carriage, xres, states, coefs, tuple(kinds),
+                   initial_states)
 
 
-def _setup(problem: FitProblem, transcription: Transcription, cost: str, initial_state: str,
+def _setup(problem: FitProblem, transcription: Transcription, cost: str, kinds: list[str],
            blocks_ok: bool, compile_: bool | None, warm_start: FitResult | None):
-    """The assembled NLP of ``problem`` and its per-case terms."""
+    """The assembled NLP of ``problem`` and its per-case terms (``kinds``: each case's
+    initial state, "rest", "steady" or "free")."""
     if compile_ is None:
         from derive._compile import c_compiler
 
@@ -167,7 +181,7 @@ def _setup(problem: FitProblem, transcription: Transcription, cost: str, initial
     scales = np.array([e.scale for e in problem.estimated])
     theta_s = ca.MX.sym("theta", len(problem.estimated))
     warm = _warm_starts(problem, warm_start)
-    terms = [case_terms(problem, i, theta_s, transcription, cost, initial_state,
+    terms = [case_terms(problem, i, theta_s, transcription, cost, kinds[i],
                         blocks_ok, compile_, warm[i]) for i in range(len(problem.experiments))]
     return _Nlp.assemble(theta_s, problem.initial / scales, terms), terms
 
@@ -208,14 +222,15 @@ class Linearisation:
 
 def linearise(problem: FitProblem, *, warm_start: FitResult | None = None,
               transcription: Transcription = MultipleShooting(),
-              initial_state: str = "rest") -> Linearisation:
+              initial_state: str | None = None) -> Linearisation:
     """The :class:`Linearisation` of ``problem`` at its initial values, its states and
     carriage motion starting from ``warm_start`` (the current fit): what fitting it would
     gain, predicted without solving (one sparse factorisation)."""
     from .covariance import ReducedKKT
 
     est = problem.estimated
-    nlp, _ = _setup(problem, transcription, "squared", initial_state, True, False, warm_start)
+    kinds = [initial_state or e.initial_state_kind for e in problem.experiments]
+    nlp, _ = _setup(problem, transcription, "squared", kinds, True, False, warm_start)
     w0 = nlp.w0
     e, Je = ca.Function("e", [nlp.w], [nlp.e, nlp.jac_r])(w0)
     e, Je = np.asarray(e).ravel(), Je.sparse()
@@ -343,30 +358,34 @@ def _result(problem: FitProblem, theta: np.ndarray, stats: dict, recorder: Recor
             terms: list[CaseTerms], e: np.ndarray, raw: np.ndarray, report: np.ndarray,
             J: np.ndarray, Je: sps.spmatrix, Jg: sps.spmatrix, t_start: float,
             transcription: Transcription, cost_kind: str, carriage: tuple,
-            displacement_residuals: tuple, states: tuple, coefficients: tuple) -> FitResult:
+            displacement_residuals: tuple, states: tuple, coefficients: tuple,
+            initial_state_kinds: tuple[str, ...] = (),
+            initial_states: tuple[dict[str, float], ...] = ()) -> FitResult:
     measured = [t.measured for t in terms]
     weights = [t.weights for t in terms]
     nch = [1 if np.ndim(m) == 1 else m.shape[1] for m in measured]
     n_force = int(sum(np.count_nonzero(w) * c for w, c in zip(weights, nch)))
     n_disp = sum(x.size for x in displacement_residuals if x is not None)
+    at_bound = tuple(_at_bound(x, v) for x, v in zip(problem.estimated, theta))
     unc = uncertainty(Je, Jg, e, n_force + n_disp, theta.size,
-                      np.array([x.scale for x in problem.estimated]), problem.names)
+                      np.array([x.scale for x in problem.estimated]), problem.names,
+                      held=tuple(i for i, side in enumerate(at_bound) if side))
     warnings = list(unc.warnings)
     status = stats.get("return_status", "unknown")
     converged = bool(stats.get("success", False))
     if not converged:
         hint = _IPOPT_HINTS.get(status, "see IPOPT's status; try other initial values")
         warnings.append(f"IPOPT did not converge ({status}): {hint}")
-    for x, v in zip(problem.estimated, theta):
-        span = x.upper - x.lower
-        tol = 1e-4 * span if math.isfinite(span) else 1e-5 * x.scale
-        if min(v - x.lower, x.upper - v) < tol:
+    for x, v, side in zip(problem.estimated, theta, at_bound):
+        if side:
             warnings.append(f"`{x.name}` = {v:.6g} {x.unit} is at its bound "
-                            f"[{x.lower:.6g}, {x.upper:.6g}]")
+                            f"[{x.lower:.6g}, {x.upper:.6g}]: no standard error, held there in "
+                            "the covariance")
     F_all = np.concatenate([t.scaled_measured[np.tile(t.weights, c) > 0]
                             for t, c in zip(terms, nch)])
     ssr = float(report @ report)
-    derived, derived_units = derived_quantities(problem, theta, unc.covariance)
+    derived, derived_units = derived_quantities(problem, theta, unc.covariance,
+                                                np.array([side is None for side in at_bound]))
     pieces = np.split(raw, np.cumsum([int(np.size(m)) for m in measured])[:-1])
     residuals = tuple(p if np.ndim(m) == 1 else p.reshape(m.shape, order="F")
                       for p, m in zip(pieces, measured))
@@ -391,6 +410,8 @@ def _result(problem: FitProblem, theta: np.ndarray, stats: dict, recorder: Recor
         states=states, carriage_coefficients=coefficients,
         objective=float(e @ e), residual_variance=unc.sigma2,
         dof=max(n_force + n_disp - (Je.shape[1] - Jg.shape[0]), 1),
+        initial_state_kinds=initial_state_kinds, initial_states=initial_states,
+        at_bound=at_bound, bound_stderr=unc.bound_stderr,
     )
 
 
@@ -409,3 +430,15 @@ def _warm_starts(problem: FitProblem, previous: FitResult | None) -> list:
                 prev = WarmStart(old.derived.coordinates, previous.states[i], coefs)
         out.append(prev)
     return out
+
+
+def _at_bound(x, value: float) -> str | None:
+    """``"lower"`` or ``"upper"`` when the estimate sits on that bound (within 1e-4 of the
+    span between finite bounds, else 1e-5 of its scale), else ``None``."""
+    span = x.upper - x.lower
+    tol = 1e-4 * span if math.isfinite(span) else 1e-5 * x.scale
+    if value - x.lower < tol:
+        return "lower"
+    if x.upper - value < tol:
+        return "upper"
+    return None

@@ -8,7 +8,7 @@ from pathlib import Path
 
 from analogs.errors import InputError
 
-__all__ = ["read_params", "read_json"]
+__all__ = ["read_params", "read_json", "fitted_initial_state"]
 
 
 def read_json(path: str | Path, what: str) -> object:
@@ -48,3 +48,24 @@ def read_params(path: str | Path) -> dict[str, float]:
     if problems:
         raise InputError(f"{path}: " + "; ".join(problems))
     return out
+
+
+def fitted_initial_state(path: str | Path, case) -> dict[str, float]:
+    """The initial state a fit estimated for ``case`` (``[test] initial_state = "free"``),
+    from the fit result ``path`` (its ``"initial_states"`` by case id).
+
+    Raises
+    ------
+    InputError
+        When the file holds no initial state for the case.
+    """
+    data = read_json(path, "parameter file")
+    states = data.get("initial_states") if isinstance(data, dict) else None
+    entry = states.get(case.test.id) if isinstance(states, dict) else None
+    if not isinstance(entry, dict) or not all(
+            isinstance(v, (int, float)) and not isinstance(v, bool) for v in entry.values()):
+        raise InputError(f"{path}: case {case.test.id!r} starts from an estimated state "
+                         "([test] initial_state = \"free\"), but the file has no "
+                         f"`initial_states.{case.test.id}`; give the JSON `slosh fit` wrote "
+                         "for this case")
+    return {k: float(v) for k, v in entry.items()}

@@ -16,7 +16,7 @@ from ..data.case import Case
 from ..data.experiment import Experiment, experiment
 from ..data.models import model_for_case
 from .carriage import CarriageInput, RecordNoise, carriage_input, record_noise
-from .initial import length_bounds, nominal_scale, predicted_values
+from .initial import length_bounds, nominal_scale, predicted_sources, source_notes
 
 __all__ = ["FitProblem", "Estimated", "PER_CASE", "INPUT_MODES"]
 
@@ -171,7 +171,7 @@ class FitProblem:
             clash = sorted(set(names) & set(hold))
             if clash:
                 raise InputError(f"parameters both estimated and held: {', '.join(clash)}")
-        predicted = predicted_values(cases[0], model)
+        predicted, sources, failure = predicted_sources(cases[0], model, names)
         explicit = model.explicit_values()
         notes = []
         start: dict[str, float] = {}
@@ -184,7 +184,14 @@ class FitProblem:
                 start[n] = float(v)
         missing = [n for n in names if n not in start]
         if missing:
-            raise InputError(f"no initial value for {', '.join(missing)}: give `initial`")
+            why = failure or ("neither `[prediction]` nor the tank modal analysis supplies "
+                              "them (they give masses, lengths, heights and inertias of the "
+                              "fixed mass and the pendulums)")
+            raise InputError(
+                f"no initial value for {', '.join(f'`{n}`' for n in missing)}: {why}; give them "
+                f"with `initial` (e.g. `FitProblem.build(..., initial={{'{missing[0]}': ...}})`)")
+        given = set(initial_user) | set(hold) | set(explicit)
+        notes += source_notes(sources, [n for n in names if n not in given])
         g = cases[0].rig.gravity
         est = []
         for n in names:

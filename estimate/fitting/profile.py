@@ -39,7 +39,10 @@ def profile_interval(result: FitResult, name: str, level: float = 0.95, *,
         return fit(sub, progress=False).objective - threshold
 
     v_hat = float(result.values[i])
-    step = 2 * float(result.stderr[i]) or 0.01 * abs(v_hat) or est.scale * 0.01
+    se = float(result.stderr[i])
+    if not math.isfinite(se):  # at a bound: the spread the data allow away from it
+        se = float(result.bound_stderr[i]) if result.bound_stderr is not None else math.nan
+    step = (2 * se if math.isfinite(se) else 0.0) or 0.01 * abs(v_hat) or est.scale * 0.01
     ends = []
     for sign in (-1, 1):
         inner, outer = v_hat, v_hat

@@ -9,7 +9,7 @@ from typing import TYPE_CHECKING, Any
 import casadi as ca
 import numpy as np
 
-from analogs.errors import UnknownNameError
+from analogs.errors import InputError, UnknownNameError
 
 if TYPE_CHECKING:  # pragma: no cover
     from .identifiability import Identifiability
@@ -20,11 +20,14 @@ __all__ = ["FitResult", "derived_quantities"]
 _PROFILE_HINT = "`profile_interval` gives a profile-likelihood interval of a chosen parameter."
 
 
-def derived_quantities(problem: "FitProblem", theta: np.ndarray, cov: np.ndarray
+def derived_quantities(problem: "FitProblem", theta: np.ndarray, cov: np.ndarray,
+                       free: np.ndarray | None = None
                        ) -> tuple[dict[str, tuple[float, float]], dict[str, str]]:
     """The quantities the model's components derive (:meth:`analogs.Model.derived_quantities`,
     e.g. ``pN.frequency_hz`` and ``pN.damping_ratio`` with the summed hinge and diaphragm
-    terms) at the estimates of case 0, with delta-method standard errors; and their units."""
+    terms) at the estimates of case 0, with delta-method standard errors; and their units.
+    A quantity that depends on an estimate at a bound (``free`` False) has no standard
+    error (NaN)."""
     th = ca.MX.sym("theta", theta.size)
     vals: dict[str, Any] = dict(problem.fixed[0])
     for j, e in enumerate(problem.estimated):
@@ -38,6 +41,8 @@ def derived_quantities(problem: "FitProblem", theta: np.ndarray, cov: np.ndarray
     v, J = fn(theta)
     v, J = np.asarray(v).ravel(), np.asarray(J)
     se = np.sqrt(np.clip(np.einsum("ij,jk,ik->i", J, cov, J), 0, None))
+    if free is not None and not np.all(free):
+        se[np.any(J[:, ~np.asarray(free, bool)] != 0, axis=1)] = np.nan
     values = {k: (float(a), float(b)) for k, a, b in zip(found, v, se)}
     return values, {k: unit for k, (_, unit) in found.items()}
 
@@ -110,6 +115,17 @@ class FitResult:
     objective: float = math.nan
     residual_variance: float = math.nan
     dof: int = 1
+    #: Per case, where the analog started (``"rest"``, ``"steady"`` or ``"free"``) and the
+    #: state at the first sample (rad, m, rad/s, m/s by state name) at the estimates.
+    initial_state_kinds: tuple[str, ...] = ()
+    initial_states: tuple[dict[str, float], ...] = field(default=(), repr=False)
+    #: Per estimate, ``"lower"``/``"upper"`` when it ended at that (active) bound, else
+    #: ``None``. Such an estimate has no Wald standard error (``stderr`` is NaN, its
+    #: covariance rows and columns are zero, its correlations NaN) and is left out of the
+    #: identifiability check; ``bound_stderr`` gives the standard deviation the data allow
+    #: it away from the bound (NaN when they do not determine it), for a one-sided interval.
+    at_bound: tuple[str | None, ...] = ()
+    bound_stderr: np.ndarray | None = field(default=None, repr=False)
 
     def scaled_residuals(self, case: int = 0) -> np.ndarray:
         """Residuals of ``case`` divided by their channel scales (what the cost sums):
@@ -151,19 +167,67 @@ class FitResult:
                                    f"{', '.join(self.names)}") from None
 
     @property
+    def free(self) -> tuple[bool, ...]:
+        """Per estimate, whether it is inside its bounds (has a Wald standard error)."""
+        return tuple(not self.at_bound or self.at_bound[i] is None for i in range(len(self.names)))
+
+    @property
     def correlation(self) -> np.ndarray:
+        """Correlations of the estimates (in [-1, 1]; NaN for estimates at a bound)."""
         d = np.sqrt(np.clip(np.diag(self.covariance), 0, None))
         with np.errstate(invalid="ignore", divide="ignore"):
-            c = self.covariance / np.outer(d, d)
-        return np.nan_to_num(c)
+            c = np.clip(np.nan_to_num(self.covariance / np.outer(d, d), nan=0.0, posinf=0.0,
+                                      neginf=0.0), -1.0, 1.0)
+        bound = ~np.array(self.free, bool)
+        c[bound, :] = np.nan
+        c[:, bound] = np.nan
+        return c
 
     def interval(self, name: str, level: float = 0.95) -> tuple[float, float]:
-        """Wald interval from the Gauss-Newton covariance (t distribution)."""
+        """Wald interval from the Gauss-Newton covariance (t distribution); for an estimate
+        at a bound the one-sided interval from the bound (:meth:`one_sided_limit`), up to
+        the other bound when the data do not determine it."""
         from scipy.stats import t as student
 
         i = self._index(name)
+        if not self.free[i]:
+            e = self.problem.estimated[i]
+            limit = self.one_sided_limit(name, level)
+            if self.at_bound[i] == "lower":
+                return float(e.lower), (float(e.upper) if limit is None else limit)
+            return (float(e.lower) if limit is None else limit), float(e.upper)
         q = student.ppf(0.5 + level / 2, self.dof)
         return float(self.values[i] - q * self.stderr[i]), float(self.values[i] + q * self.stderr[i])
+
+    def one_sided_limit(self, name: str, level: float = 0.95) -> float | None:
+        """For an estimate at a bound: the one-sided ``level`` confidence limit away from
+        the bound (``bound +/- t_level * bound_stderr``), ``None`` when the data do not
+        determine it; raises for an estimate inside its bounds."""
+        from scipy.stats import t as student
+
+        i = self._index(name)
+        side = self.at_bound[i] if self.at_bound else None
+        if side is None:
+            raise InputError(f"`{name}` is not at a bound; use `interval`")
+        se = float(self.bound_stderr[i]) if self.bound_stderr is not None else math.nan
+        if not math.isfinite(se):
+            return None
+        q = float(student.ppf(level, self.dof))
+        e = self.problem.estimated[i]
+        return float(e.lower + q * se) if side == "lower" else float(e.upper - q * se)
+
+    def uncertainty_text(self, i: int) -> str:
+        """``+/- se`` of estimate ``i``, or what stands for it at a bound."""
+        if self.free[i]:
+            return f"+/- {self.stderr[i]:.3g}"
+        e = self.problem.estimated[i]
+        side = self.at_bound[i]
+        limit = self.one_sided_limit(self.names[i])
+        bound = e.lower if side == "lower" else e.upper
+        if limit is None:
+            return f"at its {side} bound {bound:.6g} (not determined by the data)"
+        return (f"at its {side} bound {bound:.6g} (one-sided 95 %: "
+                f"{'<=' if side == 'lower' else '>='} {limit:.3g})")
 
     @property
     def case_values(self) -> list[dict[str, float]]:
@@ -184,7 +248,8 @@ class FitResult:
             combos = [k for k in self.derived if k.split(".")[0] in comps and k.endswith("frequency_hz")]
             for k in combos:
                 v, se = self.derived[k]
-                text += f"; the identifiable combination is {k} = {v:.5g} +/- {se:.2g} Hz"
+                if math.isfinite(se):
+                    text += f"; the identifiable combination is {k} = {v:.5g} +/- {se:.2g} Hz"
             out.append(text)
         return out
 
@@ -210,10 +275,15 @@ class FitResult:
     def to_dict(self) -> dict[str, Any]:
         """The fixed-key JSON form written by ``slosh fit``."""
         params: dict[str, Any] = {}
-        for name, v, se, e in zip(self.names, self.values, self.stderr, self.problem.estimated):
-            params[name] = {"value": float(v), "stderr": float(se), "unit": e.unit,
-                            "lower": _json_bound(e.lower), "upper": _json_bound(e.upper),
-                            "estimated": True}
+        free = self.free
+        for i, (name, v, se, e) in enumerate(zip(self.names, self.values, self.stderr,
+                                                 self.problem.estimated)):
+            params[name] = {"value": float(v), "stderr": float(se) if free[i] else None,
+                            "unit": e.unit, "lower": _json_bound(e.lower),
+                            "upper": _json_bound(e.upper), "estimated": True}
+            if not free[i]:
+                params[name] |= {"at_bound": self.at_bound[i],
+                                 "one_sided_95": self.one_sided_limit(name)}
         units = {p.name: p.unit for p in self.problem.experiments[0].derived.parameters}
         needed = set(self.problem.experiments[0].derived.needed_parameters())
         for name, v in self.problem.fixed[0].items():
@@ -226,10 +296,17 @@ class FitResult:
             "model_spec": getattr(model, "spec", None) or ",".join(model.names),
             "cases": [str(e.case.path) for e in self.problem.experiments],
             "parameters": params,
-            "covariance": {"parameters": list(self.names), "matrix": self.covariance.tolist()},
-            "correlation": self.correlation.tolist(),
+            # estimates at a bound have no covariance: both matrices hold the others only
+            "covariance": {"parameters": [n for n, f in zip(self.names, free) if f],
+                           "matrix": self.covariance[np.ix_(free, free)].tolist()},
+            "correlation": self.correlation[np.ix_(free, free)].tolist(),
+            "initial_states": {e.case.test.id: dict(x) for e, x in
+                               zip(self.problem.experiments, self.initial_states)},
+            "initial_state": {e.case.test.id: k for e, k in
+                              zip(self.problem.experiments, self.initial_state_kinds)},
             "derived": {k: v for k, (v, _) in self.derived.items()},
-            "derived_stderr": {k: se for k, (_, se) in self.derived.items()},
+            "derived_stderr": {k: se if math.isfinite(se) else None
+                               for k, (_, se) in self.derived.items()},
             "derived_units": dict(self.derived_units),
             "cost": self.cost,
             "rms_residual": self.rms_residual,
@@ -266,7 +343,12 @@ class FitResult:
                  f"    RMS residual       = {self.rms_residual:.6g} {'N' if single else '(scaled)'}",
                  f"    R^2                = {self.r_squared:.6f}",
                  "[[Variables]]"]
-        for name, v, se, e in zip(self.names, self.values, self.stderr, self.problem.estimated):
+        for i, (name, v, se, e) in enumerate(zip(self.names, self.values, self.stderr,
+                                                 self.problem.estimated)):
+            if not self.free[i]:
+                lines.append(f"    {name:28s} = {v:.6g} {e.unit} {self.uncertainty_text(i)}  "
+                             f"(init {e.initial:.4g})")
+                continue
             rel = f"({abs(se / v) * 100:.2f}%)" if v else ""
             lo, hi = self.interval(name)
             lines.append(f"    {name:28s} = {v:.6g} +/- {se:.3g} {rel:10s} {e.unit:12s} "
@@ -274,11 +356,14 @@ class FitResult:
         if self.derived:
             lines.append("[[Derived]]")
             for k, (v, se) in self.derived.items():
-                lines.append(f"    {k:28s} = {v:.6g} +/- {se:.3g} {self.derived_units.get(k, '')}")
+                unit = self.derived_units.get(k, "")
+                lines.append(f"    {k:28s} = {v:.6g} +/- {se:.3g} {unit}" if math.isfinite(se)
+                             else f"    {k:28s} = {v:.6g} {unit} (no standard error: it depends "
+                             "on an estimate at a bound)")
         corr = self.correlation
         pairs = [(abs(corr[i, j]), self.names[i], self.names[j], corr[i, j])
                  for i in range(len(self.names)) for j in range(i + 1, len(self.names))]
-        pairs = sorted((p for p in pairs if p[0] > 0.1), reverse=True)
+        pairs = sorted((p for p in pairs if p[0] > 0.1), reverse=True)  # NaN (at a bound) fails
         if pairs:
             lines.append("[[Correlations]] (|C| > 0.1)")
             for _, a, b, c in pairs:
@@ -287,7 +372,12 @@ class FitResult:
         lines.append("    condition number of the scaled sensitivity = "
                      f"{self.identifiability.condition_number:.3g}")
         conf = self.confounded()
-        lines += [f"    {c}" for c in conf] or ["    every estimated parameter is determined by the data"]
+        bound = [n for n, f in zip(self.names, self.free) if not f]
+        inside = " inside its bounds" if bound else ""
+        lines += [f"    {c}" for c in conf] or [f"    every estimated parameter{inside} is "
+                                                "determined by the data"]
+        if bound:
+            lines.append(f"    left out (at a bound): {', '.join(f'`{n}`' for n in bound)}")
         if not single:
             lines.append("[[Channels]] (residual scale, RMS residual / scale)")
             for i, names in enumerate(self.channels):

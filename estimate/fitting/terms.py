@@ -17,6 +17,7 @@ from derive import OUTPUT_NAMES, RK4, Sampled, simulate
 from ..data.signals import lowpass
 from ._sparse import sparse_dm
 from .problem import FitProblem
+from .steady import steady_start
 from .transcription import Block, InputCoefficients, Transcription
 
 __all__ = ["CaseTerms", "WarmStart", "case_terms"]
@@ -134,12 +135,17 @@ def case_terms(problem: FitProblem, i: int, theta_s: ca.MX, transcription: Trans
         guess = warm.states
     elif dm.nx:
         values0 = problem.case_values(i, problem.initial)
-        guess = simulate(dm, values0, t, excitation, integrator=RK4()).states.T
+        start = exp.initial_state(values0) if initial_state == "steady" else None
+        guess = simulate(dm, values0, t, excitation, integrator=RK4(), x0=start).states.T
     else:
         guess = np.zeros((0, n))
     x0 = np.zeros(dm.nx) if initial_state == "rest" else None
     block = transcription.block(dm, p_i, t, U, guess, x0, theta=theta_s if blocks_ok else None,
                                 compiled=compile_, coefficients=coefficients)
+    if initial_state == "steady" and dm.nx:
+        u0 = excitation.values(t[:1]) if dm.nu else np.zeros((0, 1))
+        block = steady_start(block, dm, p_i, theta_s, np.asarray(u0).ravel(), float(t[0]),
+                             coef.numel())
     chans = problem.channels(i)
     Y = _measured_output(dm, chans).map(n)(block.X, Ug, p_i, ca.DM(t).T).T
     mvals = {e.parameter: theta_s[j] * e.scale for j, e in enumerate(problem.estimated)
@@ -178,7 +184,7 @@ def case_terms(problem: FitProblem, i: int, theta_s: ca.MX, transcription: Trans
         e = ca.vertcat(e, ex)
         r = e if cost == "squared" else ca.vertcat(r, ex)
     return CaseTerms(block, coef, coef0, r, e, raw, report, F, wts,
-                     scaled_measured, x0 is None,
+                     scaled_measured, initial_state == "free" and dm.nx > 0,
                      None if carriage is None else ca.reshape(Ug, dm.nu, n), x_resid)
 
 

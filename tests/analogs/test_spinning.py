@@ -7,6 +7,7 @@ import math
 import numpy as np
 import pytest
 import sympy as sp
+from symbolic_helpers import as_functions
 from tolerances import SYMBOLIC
 
 from analogs import FixedMass, Pendulum, Rotor, SphericalPendulum
@@ -68,15 +69,6 @@ def _spinning_frame_residual(rho, q, W, g_vec, m, t):
     return [sp.expand(m * a.dot(rho.diff(qi))) for qi in q]
 
 
-def _as_functions(sym, names):
-    t = sym.t
-    funcs = [sp.Function(n)(t) for n in names]
-    rule = {}
-    for i, f in enumerate(funcs):
-        rule.update({sym.qdd[i]: f.diff(t, 2), sym.qd[i]: f.diff(t), sym.q[i]: f})
-    return funcs, rule
-
-
 @pytest.mark.parametrize("gravity", [True, False])
 def test_spherical_pendulum_inward_tank_matches_coriolis_centrifugal_hand_derivation(gravity):
     sym = assemble(SpinningRig(tank_axis="inward", gravity=gravity) + SphericalPendulum("p1"))
@@ -85,7 +77,7 @@ def test_spherical_pendulum_inward_tank_matches_coriolis_centrifugal_hand_deriva
     W, r = P["rig.spin_rate"], P["rig.radius"]
     g = P["rig.gravity"] if gravity else 0
     t = sym.t
-    (a, b), rule = _as_functions(sym, ("a", "b"))
+    (a, b), rule = as_functions(sym, ("a", "b"))
     # bob in spin-frame coordinates (x radial, y tangential, z spin axis): the tank axis
     # points inward (T.z = -S.x), T.x = S.z, T.y = S.y
     tank = (L * sp.sin(a) * sp.cos(b), L * sp.sin(b), h - L * sp.cos(a) * sp.cos(b))
@@ -159,7 +151,7 @@ def test_spherical_pendulum_on_nutating_table_matches_inertial_dalembert():
     P = _params(sym)
     m, L, h = P["p1.mass"], P["p1.length"], P["p1.hinge_height"]
     t = sym.t
-    (a, b), rule = _as_functions(sym, ("a", "b"))
+    (a, b), rule = as_functions(sym, ("a", "b"))
     R = _table_rotation(sym)
     bob_t = sp.Matrix([P["rig.radius"] + L * sp.sin(a) * sp.cos(b), L * sp.sin(b),
                        h - L * sp.cos(a) * sp.cos(b)])

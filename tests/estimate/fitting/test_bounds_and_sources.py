@@ -1,0 +1,107 @@
+"""Honest reports at bounds (no Wald interval, no correlation, no standard error of 0) and
+initial values whose source the notes name."""
+
+import json
+import re
+
+import numpy as np
+import pytest
+import reference_models as ref
+from synthetic_cases import PREDICTION_60, make_case, pendulum
+
+from analogs.errors import InputError
+from estimate import FitProblem, fit, model_from_spec
+from estimate.data import write_case
+from estimate.data.case import Liquid, Rig, Spin, Tank, TestInfo
+
+
+@pytest.fixture(scope="module")
+def pinned_fit(tmp_path_factory):
+    """A lateral fit whose pendulum length is bounded above the truth: it ends at the bound."""
+    p = pendulum()
+    f1 = ref.natural_frequency(p, 9.80665) / (2 * np.pi)
+    case, _ = make_case(tmp_path_factory.mktemp("bound"), "B1",
+                        ref.Ramped(ref.Sine(0.003, 0.95 * f1), 1.5, 0.0), pendulums=[p],
+                        fixed_mass=1.5, duration=12.0, seed=2)
+    prob = FitProblem.build(case, model_from_spec("fixed,p1:nospring", case),
+                            bounds={"p1.length": (1.01 * p.length, 0.07)})
+    return fit(prob, progress=False), p
+
+
+def test_estimate_at_a_bound_has_no_wald_interval_and_no_correlation(pinned_fit):
+    res, p = pinned_fit
+    i = res.names.index("p1.length")
+    assert res.at_bound[i] == "lower" and not res.free[i]
+    assert np.isnan(res.stderr[i])
+    lo, hi = res.interval("p1.length")
+    assert lo == pytest.approx(1.01 * p.length) and lo < hi < 1.02 * p.length  # one-sided
+    c = res.correlation
+    assert np.all(np.isnan(c[i])) and np.all(np.isnan(c[:, i]))
+    others = np.delete(np.delete(c, i, 0), i, 1)
+    assert np.all(np.isfinite(others)) and np.all(np.abs(others) <= 1.0)
+    assert all("p1.length" not in g for g in res.identifiability.groups)
+    # the report says so instead of printing numbers that look meaningful
+    text = res.report()
+    assert re.search(r"p1\.length +=\s+\S+ m at its lower bound [\d.]+ \(one-sided 95 %: <= ", text)
+    assert "left out (at a bound): `p1.length`" in text
+    assert not re.search(r"\+/- 0(\s|$)", text)  # no standard error of 0
+    assert "p1.frequency_hz" in text and "no standard error: it depends on an estimate at a " \
+                                        "bound" in text
+
+
+def test_json_at_a_bound_has_null_stderr_and_only_free_correlations(pinned_fit):
+    res, _ = pinned_fit
+    data = json.loads(json.dumps(res.to_dict(), allow_nan=False))  # strict JSON: no NaN
+    entry = data["parameters"]["p1.length"]
+    assert entry["stderr"] is None and entry["at_bound"] == "lower"
+    assert entry["one_sided_95"] > entry["value"]
+    free = [n for n, v in data["parameters"].items() if v.get("estimated") and "at_bound" not in v]
+    assert data["covariance"]["parameters"] == free
+    corr = np.array(data["correlation"])
+    assert corr.shape == (len(free), len(free)) and np.all(np.abs(corr) <= 1.0)
+    assert all(v["stderr"] != 0 for v in data["parameters"].values())
+    assert data["derived_stderr"]["p1.frequency_hz"] is None
+
+
+@pytest.fixture()
+def spinning_case_with_prediction(tmp_path):
+    t = np.arange(101) * 0.01
+    rng = np.random.default_rng(0)
+    chans = ("force_x", "force_y", "force_z", "torque_x", "torque_y", "torque_z")
+    return write_case(tmp_path / "P1.toml",
+                      test=TestInfo("P1", "spinning", "P1.csv", "spin"),
+                      tank=Tank("sphere", 0.1016, 0.6, False), liquid=Liquid(998.2, 1.004e-6),
+                      rig=Rig(2.0, 9.80665, spin=Spin(6.0, 0.4, 0.0, 0.0)), time=t,
+                      channels={c: rng.standard_normal(t.size) for c in chans},
+                      prediction=PREDICTION_60)
+
+
+def test_heights_missing_from_the_prediction_come_from_the_tank_analysis(
+        spinning_case_with_prediction):
+    case = spinning_case_with_prediction
+    prob = FitProblem.build(case, model_from_spec("fixed,p1", case))
+    notes = "\n".join(prob.notes)
+    assert re.search(r"initial values from \[prediction\]: `fixed.mass`, `p1.mass`, `p1.length`",
+                     notes)
+    analysis = re.search(r"initial values from the tank modal analysis \(sphere R = 0.1016 m, "
+                         r"60 % fill\): (.*)", notes).group(1)
+    for name in ("fixed.height", "fixed.inertia", "fixed.axial_inertia", "p1.hinge_height"):
+        assert f"`{name}`" in analysis
+    start = {e.name: e.initial for e in prob.estimated}
+    assert start["p1.mass"] == PREDICTION_60.pendulum_mass  # the prediction wins where it speaks
+    assert start["p1.hinge_height"] == pytest.approx(0.1016, rel=1e-6)  # sphere: at the centre
+
+
+def test_no_source_for_a_height_is_a_clear_error(spinning_case_with_prediction, monkeypatch):
+    import estimate.fitting.initial as initial
+
+    def broken(case, modes):
+        raise InputError("fill fraction outside the solver's range")
+
+    monkeypatch.setattr(initial, "_tank_prediction", broken)
+    case = spinning_case_with_prediction
+    with pytest.raises(InputError, match=r"no initial value for `fixed.height`, .*"
+                                         r"`p1.hinge_height`: the tank modal analysis failed: fill "
+                                         r"fraction outside the solver's range; give them with "
+                                         r"`initial`"):
+        FitProblem.build(case, model_from_spec("fixed,p1", case))

@@ -1,0 +1,159 @@
+"""Spinning-rig records as the SSTR makes them, from the independent reference simulator
+(``tests/reference_spinning.py``: hand-written Newton-Euler equations, SciPy DOP853):
+
+(a) an off-axis record (r = 0.4 m) that spins the table up over 12 s and ramps the coning in
+    over 5 s, with the table angles recorded in the CSV (``[rig.spin] spin_angle``, ...);
+(b) an off-axis record that starts in steady spin (the pendulum on its cone, ~59 deg from
+    the tank axis; ``[test] initial_state = "steady"``) with a rotor hidden, the coning
+    ramped in after 1 s.
+
+Both are hard the way rig records are (``/work/shared/notes/test-records.md``): 1.5 % white
+noise on all six channels, a 23 Hz motor tone of 2 % and a transducer drift of 1 % of each
+channel's standard deviation over the record.
+
+The fits and the diagnosis take minutes: they are marked slow (``pytest -m slow``).
+"""
+
+import json
+import math
+
+import numpy as np
+import pytest
+import reference_spinning as rs
+from synthetic_cases import make_spinning_case
+
+from estimate import FitProblem, fit, model_from_spec
+from estimate.cli import main
+
+#: Issue 16 acceptance: masses within 2 %, the pendulum frequency within 0.5 %, each mass
+#: within 3 of its stated standard errors.
+MASS_TOL, FREQ_TOL, N_SE = 0.02, 0.005, 3.0
+
+PEND = rs.SphericalPendulum(1.25, 0.062, 0.035, damping=5e-4)
+ROTOR = rs.Rotor(0.01, 0.04, axis="y")
+FIXED_MASS, FIXED_HEIGHT = 1.5, 0.05
+#: Hard record: white noise, a motor tone (fraction of each channel's std, Hz), drift.
+HARD = {"noise": 0.015, "tone": (0.02, 23.0), "drift": 0.01}
+#: A table encoder of 16 bits: quantisation noise 2 pi / 2^16 / sqrt(12) ~ 3e-5 rad.
+ENCODER_NOISE = 3e-5
+
+RIG_A = rs.Rig(spin_rate=6.0, radius=0.4, height=0.1, nutation_angle=0.06,
+               nutation_frequency=-0.5, dry_mass=2.0, spin_up=12.0, nutation_ramp=5.0)
+RIG_B = rs.Rig(spin_rate=6.0, radius=0.4, height=0.1, nutation_angle=0.06,
+               nutation_frequency=-0.5, dry_mass=2.0, nutation_ramp=3.0, nutation_start=1.0)
+
+
+def _pendulum_frequency_hz(length: float, gravity: float = rs.STANDARD_GRAVITY) -> float:
+    """The pendulum's frequency as ``pN.frequency_hz`` defines it: sqrt(g / L) / 2 pi."""
+    return math.sqrt(gravity / length) / (2 * math.pi)
+
+
+def _check_masses(res, truth):
+    for name, value in truth.items():
+        est, se = res.value(name), res.stderr[res.names.index(name)]
+        assert est == pytest.approx(value, rel=MASS_TOL), name
+        assert abs(est - value) <= N_SE * se, (name, est, value, se)
+
+
+@pytest.fixture(scope="module")
+def record_a(tmp_path_factory):
+    case, _ = make_spinning_case(tmp_path_factory.mktemp("a"), "A1", RIG_A, pendulum=PEND,
+                                 fixed_mass=FIXED_MASS, fixed_height=FIXED_HEIGHT, seed=11,
+                                 tank_radius=0.1016, duration=30.0, measured_angles=True,
+                                 angle_noise=ENCODER_NOISE, **HARD)
+    return case
+
+
+@pytest.fixture(scope="module")
+def fit_a(record_a):
+    case = record_a
+    assert case.spin.motion == "input" and set(case.spin.columns) == {
+        "spin_angle", "nutation_phase", "cone_angle"}
+    prob = FitProblem.build(case, model_from_spec("fixed,p1:nospring", case),
+                            hold={"fixed.inertia": 0.0, "fixed.axial_inertia": 0.0})
+    res = fit(prob, progress=False)
+    print(f"\n(a) fit {res.seconds:.1f} s:", {n: round(float(v), 6) for n, v in
+                                           zip(res.names, res.values)})
+    return res
+
+
+@pytest.mark.slow
+def test_a_spin_up_and_cone_ramp_from_measured_table_angles(fit_a):
+    res = fit_a
+    assert res.converged, res.status
+    for name, value in {"fixed.mass": FIXED_MASS, "p1.mass": PEND.mass}.items():
+        assert res.value(name) == pytest.approx(value, rel=MASS_TOL), name
+    f_hz = res.derived["p1.frequency_hz"][0]
+    assert f_hz == pytest.approx(_pendulum_frequency_hz(PEND.length), rel=FREQ_TOL)
+
+
+@pytest.mark.slow
+@pytest.mark.xfail(strict=True, reason="the transducer drift (1 % of a channel's std over the "
+                   "record) grows with the spin-up's centrifugal force and biases the masses "
+                   "by ~3.3 standard errors (fixed.mass 1.4913 +/- 0.0027 kg, truth 1.5); "
+                   "without drift both masses are within 0.7 standard errors. Needs channel "
+                   "offsets/drifts estimated with the parameters (issue 16 notes).")
+def test_a_masses_within_three_standard_errors_despite_drift(fit_a):
+    _check_masses(fit_a, {"fixed.mass": FIXED_MASS, "p1.mass": PEND.mass})
+
+
+@pytest.fixture(scope="module")
+def record_b(tmp_path_factory):
+    case, sim = make_spinning_case(tmp_path_factory.mktemp("b"), "B1", RIG_B, pendulum=PEND,
+                                   rotor=ROTOR, fixed_mass=FIXED_MASS,
+                                   fixed_height=FIXED_HEIGHT, seed=12, tank_radius=0.1016,
+                                   duration=15.0, steady=True, **HARD)
+    return case, sim
+
+
+@pytest.mark.slow
+@pytest.mark.xfail(strict=True, reason="issue 16 session: converges with fixed.mass 1.21 "
+                   "(truth 1.5) on this 15 s steady-start record with a 3 s cone ramp: the "
+                   "fixed/pendulum mass split is not determined without a spin-up; see notes")
+def test_b_steady_start_with_the_rotor_fits(record_b):
+    case, sim = record_b
+    assert case.test.initial_state == "steady"
+    assert np.degrees(sim["states"][0, 0]) == pytest.approx(59.0, abs=0.5)  # on its cone
+    prob = FitProblem.build(case, model_from_spec("fixed,p1:nospring,r1", case),
+                            hold={"fixed.inertia": 0.0, "fixed.axial_inertia": 0.0},
+                            initial={"r1.inertia": 0.005, "r1.damping": 0.02})
+    res = fit(prob, progress=False)
+    assert res.converged, res.status
+    assert res.initial_state_kinds == ("steady",)
+    # the fitted start is the conical equilibrium of the fitted pendulum
+    assert math.degrees(res.initial_states[0]["p1.alpha"]) == pytest.approx(59.0, abs=1.0)
+    _check_masses(res, {"fixed.mass": FIXED_MASS, "p1.mass": PEND.mass})
+    f_hz = res.derived["p1.frequency_hz"][0]
+    assert f_hz == pytest.approx(_pendulum_frequency_hz(PEND.length), rel=FREQ_TOL)
+    print(f"\n(b) fit {res.seconds:.1f} s:", {n: round(float(v), 6) for n, v in
+                                           zip(res.names, res.values)})
+
+
+@pytest.mark.slow
+def test_b_fits_from_the_command_line_with_honest_bounds(record_b, tmp_path):
+    case, _ = record_b
+    out = tmp_path / "fit.json"
+    assert main(["fit", str(case.path), "--model", "fixed,p1:nospring,r1",
+                 "--json", str(out)]) == 0
+    data = json.loads(out.read_text(), parse_constant=lambda c: pytest.fail(f"JSON has {c}"))
+    assert data["initial_state"] == {"B1": "steady"}
+    assert set(data["initial_states"]["B1"]) == {"p1.alpha", "p1.beta", "r1.psi",
+                                                 "p1.alpha_dot", "p1.beta_dot", "r1.psi_dot"}
+    p = data["parameters"]
+    corr = np.array(data["correlation"])
+    assert corr.shape == (len(data["covariance"]["parameters"]),) * 2
+    assert np.all(np.abs(corr) <= 1.0)
+    assert all(v["stderr"] is None or v["stderr"] > 0 for v in p.values() if v["estimated"])
+    assert all(("at_bound" in v) == (v["stderr"] is None) for v in p.values() if v["estimated"])
+
+
+@pytest.mark.slow
+@pytest.mark.xfail(strict=True, reason="issue 16 session: on this 15 s steady-start record "
+                   "(3 s cone ramp) the baseline fit lands at p1.mass 1.64, p1.length 0.052 "
+                   "(truth 1.25, 0.062) and the diagnosis finds nothing; see the notes")
+def test_b_diagnose_names_the_hidden_rotor_from_a_steady_start(record_b):
+    from estimate import diagnose
+
+    case, _ = record_b
+    d = diagnose(case)
+    assert [f.cause for f in d.findings][:1] == ["rotor"], d.rounds
