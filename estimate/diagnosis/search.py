@@ -49,6 +49,9 @@ MIN_HELDOUT_CHI2 = 9.0
 #: Score statistic a screened candidate needs to be fitted (5 standard deviations for one
 #: new parameter: a dozen candidates are screened each round).
 MIN_SCORE = 25.0
+#: A library term is fitted besides accepted named families when its score is this many
+#: times the best named family's.
+LIBRARY_DOMINANCE = 2.0
 #: Screened candidates fitted per round, best scores first.
 MAX_SCREENED_FITS = 2
 
@@ -340,8 +343,11 @@ def _round(fitter: _Fitter, current: FitResult, evidence: Evidence, predicted, g
             f"not tried: no timing skew in the residual (correlation with dF/dt "
             f"{evidence.skew_correlation:+.2f}, implied delay {1e3 * evidence.skew_delay:.1f} ms)",
             "", current))
-    if not any(o.rejected is None for o in outcomes):
-        # the library route: a hinge torque term no named family describes
+    named_best = max((sc.statistic for sc in named if sc.unphysical is None), default=0.0)
+    if not any(o.rejected is None for o in outcomes) or \
+            (library and library[0].statistic > LIBRARY_DOMINANCE * named_best):
+        # the library route: a hinge torque term no named family describes (also when its
+        # score dwarfs every named family's, which then only bends around the effect)
         for sc in library[:1]:
             if sc.statistic >= MIN_SCORE:
                 text = f"score {sc.statistic:.0f} (chi-square, {sc.dof} dof)"

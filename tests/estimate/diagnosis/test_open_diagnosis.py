@@ -113,9 +113,9 @@ RECORDS: dict[str, Record] = {
     # torque at 0.3 rad; no family is even in the angle
     "outside_asymmetric": Record(STEPS_A, (with_(P1, extra=lambda th, thd: 0.13 * th**2),),
                                  outside=True, seed=41, effects={"tone": TONE}),
-    # a transducer that reads ~8 % low at the peak force (soft saturation): not the analog
+    # a transducer that reads ~12 % low at the peak force (soft saturation): not the analog
     "outside_saturation": Record(SWEEP, (P1,), outside=True, seed=42,
-                                 effects={"tone": TONE, "saturation": 20.0}),
+                                 effects={"tone": TONE, "saturation": 15.0}),
 }
 DEFAULT = ("friction_a", "cubic_b", "ctrl_offset", "outside_asymmetric")
 
