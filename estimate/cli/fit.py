@@ -45,6 +45,8 @@ def run(args: argparse.Namespace) -> int:
     outputs = Outputs(overwrite=args.overwrite, inputs=args.cases)
     outputs.file("--json", args.json_out).file("--plot", args.plot).check()
     cases, notes = load_cases(args.cases, prediction=True)
+    for w in notes:  # before the fit, which starts from [prediction]
+        print(f"warning: {w}", file=sys.stderr)
     spec = BASELINE if args.model is None else args.model
     model = model_from_spec(spec, cases[0])
     mode = args.input or ("filtered" if args.cost == "abs" else "estimated")
@@ -61,7 +63,7 @@ def run(args: argparse.Namespace) -> int:
             print(f"  {n:30s} {v:.6g} +/- {se:.2g} {u}")
         for c in result.confounded():
             print(f"  note: {c}")
-    for w in (*notes, *result.warnings):
+    for w in result.warnings:
         print(f"warning: {w}", file=sys.stderr)
     with outputs.writing() as paths:
         if args.json_out:

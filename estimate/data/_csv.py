@@ -10,7 +10,7 @@ from typing import Any
 import numpy as np
 
 from .budget import decimation_hint, max_samples
-from .case import MIN_SAMPLES, SPINNING_CHANNELS, TIME_STEP_RTOL
+from .case import MIN_DURATION, MIN_SAMPLES, SPINNING_CHANNELS, TIME_STEP_RTOL
 
 __all__ = ["read_csv"]
 
@@ -195,6 +195,10 @@ def _read_rows(reader, n_lines: int, name: str, excitation: str | None, problems
             where = [int(lines[i + 1]) for i in nonincreasing]
             problems.append(f"{name}: column `time`: expected strictly increasing times, found "
                             f"{nonincreasing.size} decrease(s) or repeat(s) at {_rows_text(where)}")
+        elif n >= MIN_SAMPLES and t[-1] - t[0] < MIN_DURATION:
+            problems.append(f"{name}: column `time`: expected a record of at least "
+                            f"{MIN_DURATION:g} s (times in seconds), found {t[-1] - t[0]:.3g} s "
+                            f"({n} samples at a step of {float(np.median(dt)):.3g} s)")
         else:
             step = float(np.median(dt))
             off = np.flatnonzero(np.abs(dt - step) > TIME_STEP_RTOL * step)

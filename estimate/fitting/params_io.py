@@ -40,14 +40,16 @@ def read_params(path: str | Path) -> dict[str, float]:
     """
     path = Path(path)
     data = read_json(path, "parameter file")
-    if isinstance(data, dict) and isinstance(data.get("parameters"), dict):
+    where = "{}"
+    if isinstance(data, dict) and isinstance(data.get("parameters"), dict):  # a fit result
         data = {k: (v.get("value") if isinstance(v, dict) else v) for k, v in data["parameters"].items()}
+        where = "parameters.{}.value"
     if not isinstance(data, dict):
         raise InputError(f"{path}: expected a JSON object of parameter values, found {type(data).__name__}")
     out, problems = {}, []
     for key, value in data.items():
         if isinstance(value, bool) or not isinstance(value, (int, float)) or not math.isfinite(value):
-            problems.append(f"`{key}`: expected a finite number, found {value!r}")
+            problems.append(f"`{where.format(key)}`: expected a finite number, found {value!r}")
         else:
             out[key] = float(value)
     if problems:
