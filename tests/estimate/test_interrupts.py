@@ -148,3 +148,40 @@ def test_handled_remembers_the_signal_and_deferred_holds_it_back():
             with deferred():
                 pass
     assert signal.getsignal(signal.SIGTERM) is signal.SIG_DFL
+
+
+_STUCK = """
+import sys, time
+from pathlib import Path
+from estimate.interrupts import handled, temporary
+tmp = Path(sys.argv[1])
+tmp.write_text("partial")
+with handled("slosh stuck"), temporary([tmp]):
+    print("ready", flush=True)
+    while True:  # code that swallows every interrupt, like a native loop that never returns
+        try:
+            time.sleep(0.05)
+        except KeyboardInterrupt:
+            pass
+"""
+
+
+def test_a_command_that_does_not_stop_is_ended_by_the_watchdog(tmp_path):
+    """After GRACE_SECONDS the watchdog ends the process with the signal's status and
+    removes the temporary output files it was told about."""
+    tmp = tmp_path / ".out.json.partial"
+    proc = subprocess.Popen([sys.executable, "-c", _STUCK, str(tmp)], stdout=subprocess.PIPE,
+                            stderr=subprocess.PIPE, env=_env())
+    try:
+        assert proc.stdout.readline() == b"ready\n"
+        start = time.monotonic()
+        proc.send_signal(signal.SIGINT)
+        _, err = proc.communicate(timeout=30)
+        waited = time.monotonic() - start
+    finally:
+        if proc.poll() is None:
+            proc.kill()
+    assert proc.returncode == 130, err
+    assert b"slosh stuck: interrupted by SIGINT; it did not stop within 5 s" in err
+    assert 4.5 < waited < 15.0
+    assert not tmp.exists()

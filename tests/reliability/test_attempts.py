@@ -181,7 +181,7 @@ def _attempts(d: Path) -> dict[str, Attempt]:
         "montecarlo: a fit value that is text names file and key": Attempt(
             ["montecarlo", _fit_file(d, _text_value), a1, "--samples", "2", "--local",
              "--out", str(d / "mc")], 2,
-            err=("_text_value.json: `parameters.fixed.mass.value`: expected a finite number")),
+            err=("_text_value.json: `parameters.fixed.mass.value`: expected a finite number",)),
         "montecarlo: covariance = [1, 2] names file and key": Attempt(
             ["montecarlo", _fit_file(d, _tamper_covariance), a1, "--samples", "2", "--local",
              "--out", str(d / "mc")], 2,
