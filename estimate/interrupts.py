@@ -84,7 +84,8 @@ def _raise(signum: int, frame: FrameType | None) -> None:
 
 
 def received() -> int | None:
-    """The first signal received inside :func:`handled`, or None."""
+    """The first signal received inside the current :func:`handled` block, or None (also
+    outside such a block)."""
     return _received[0] if _received else None
 
 
@@ -162,6 +163,7 @@ def handled(command: str = "slosh") -> Iterator[None]:
         notify.close()
         watchdog.join(timeout=1.0)
         wake.close()
+        _received.clear()  # a signal of this command must not stop the commits of later ones
 
 
 @contextmanager
