@@ -30,8 +30,8 @@ from ._compile import c_compiler
 from .derived import OUTPUT_NAMES, OUTPUT_UNITS, DerivedModel
 from .simulate import rk4_step
 
-__all__ = ["CExport", "CFLAGS", "c_functions", "export_c", "has_c_compiler", "run_driver",
-           "state_units", "write_input_csv"]
+__all__ = ["CExport", "CFLAGS", "c_export_files", "c_functions", "export_c", "has_c_compiler",
+           "run_driver", "state_units", "write_input_csv"]
 
 #: Flags the exported code is guaranteed to compile cleanly with.
 CFLAGS = ("-std=c99", "-Wall", "-Wextra", "-O2")
@@ -159,6 +159,14 @@ def _silence_unused_parameters(code: str) -> str:
     return "\n".join(out) + "\n"
 
 
+def c_export_files(name: str = "slosh_model") -> dict[str, str]:
+    """The files :func:`export_c` writes for the symbol prefix ``name``, by role."""
+    name = _c_name(name)
+    return {"header": f"{name}.h", "wrapper": f"{name}.c", "cg_c": f"{name}_casadi.c",
+            "cg_h": f"{name}_casadi.h", "driver": "simulate_main.c", "makefile": "Makefile",
+            "params": "parameters.csv"}
+
+
 def export_c(
     model: DerivedModel | Model,
     folder: str | os.PathLike,
@@ -213,10 +221,7 @@ def export_c(
         raise InputError(f"substeps must be a positive integer, got {substeps!r}")
     folder = Path(folder).resolve()
     folder.mkdir(parents=True, exist_ok=True)
-    files = {k: folder / f for k, f in {
-        "header": f"{name}.h", "wrapper": f"{name}.c", "cg_c": f"{name}_casadi.c",
-        "cg_h": f"{name}_casadi.h", "driver": "simulate_main.c", "makefile": "Makefile",
-        "params": "parameters.csv"}.items()}
+    files = {k: folder / f for k, f in c_export_files(name).items()}
     existing = [str(p) for p in files.values() if p.exists()]
     if existing and not overwrite:
         raise FileExistsError(f"{', '.join(existing)} exist; pass overwrite=True (`--overwrite`) "

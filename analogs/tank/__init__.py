@@ -13,7 +13,7 @@ Examples
 2.091
 """
 
-from .damping import cylinder_damping, sphere_damping
+from .damping import cylinder_damping, damping_validity, sphere_damping
 from .geometry import WATER, Capsule, Cylinder, Liquid, Profile, Sphere, Tank
 from .prediction import (
                          Exact,
@@ -42,6 +42,7 @@ __all__ = [
     "Tank",
     "TankPrediction",
     "cylinder_damping",
+    "damping_validity",
     "predict",
     "sphere_damping",
 ]

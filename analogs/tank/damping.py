@@ -23,13 +23,38 @@ Checked against the sources
 
 The correlations hold for clean walls without baffles or diaphragms; a diaphragm adds
 damping that must be estimated from data.
+
+Validity
+--------
+:func:`damping_validity` says when a value is an extrapolation: the depth factor (``f``
+of the sphere, the bracket of the cylinder) more than :data:`DEPTH_FACTOR_LIMIT` times its
+reference value (half full; deep liquid) - both diverge towards empty, and the sphere's
+towards full (a 99.9 % fill gives 216 % of critical), where a wall boundary layer no longer
+describes the damping - or a sphere's ``nu / (d^1.5 g^0.5)`` outside the range above.
 """
 
 from __future__ import annotations
 
 import math
 
-__all__ = ["cylinder_damping", "sphere_damping"]
+__all__ = ["DEPTH_FACTOR_LIMIT", "SPHERE_NUMBER_RANGE", "cylinder_damping", "damping_validity",
+           "sphere_damping"]
+
+#: Largest depth factor, relative to its half-full (sphere) or deep-liquid (cylinder) value,
+#: used without a validity note: fills of about 17-87 % of a sphere's height, h/R > 0.15 in
+#: a cylinder.
+DEPTH_FACTOR_LIMIT = 3.0
+#: Range of ``nu / (d^1.5 g^0.5)`` (d the diameter) of the sphere correlation's data.
+SPHERE_NUMBER_RANGE = (1e-6, 1e-2)
+
+
+def _sphere_factor(hr: float) -> float:
+    return (1.0 + 0.46 * (2.0 - hr)) / (1.46 * (2.0 - hr)) if hr >= 1.0 else 1.0 / hr
+
+
+def _cylinder_factor(hr: float) -> float:
+    x = 1.84 * hr
+    return 1.0 + (0.318 / math.sinh(x)) * (1.0 + (1.0 - hr) / math.cosh(x))
 
 
 def sphere_damping(radius: float, depth: float, viscosity: float, gravity: float) -> float:
@@ -52,11 +77,7 @@ def sphere_damping(radius: float, depth: float, viscosity: float, gravity: float
     0.703
     """
     b = 1e4 / (2.0 * math.sqrt(2.0)) * viscosity / (radius**1.5 * math.sqrt(gravity))
-    base = 0.131 / (2.0 * math.pi) * b**0.359
-    hr = depth / radius
-    if hr >= 1.0:
-        return base * (1.0 + 0.46 * (2.0 - hr)) / (1.46 * (2.0 - hr))
-    return base / hr
+    return 0.131 / (2.0 * math.pi) * b**0.359 * _sphere_factor(depth / radius)
 
 
 def cylinder_damping(radius: float, depth: float, viscosity: float, gravity: float) -> float:
@@ -69,7 +90,37 @@ def cylinder_damping(radius: float, depth: float, viscosity: float, gravity: flo
     >>> round(cylinder_damping(1.0, 3.0, 1e-6, 9.81), 6)  # deep liquid: 0.79 Re^-1/2
     0.000449
     """
+    return (4.98 / (2.0 * math.pi) * math.sqrt(viscosity) * radius**-0.75 * gravity**-0.25
+            * _cylinder_factor(depth / radius))
+
+
+def damping_validity(shape: str, radius: float, depth: float, viscosity: float,
+                     gravity: float) -> str | None:
+    """Why the damping correlation of ``shape`` (``"sphere"`` or ``"cylinder"``) does not
+    hold at this depth and liquid, or None when it does (see the module docstring).
+
+    Parameters as :func:`sphere_damping` (m, m, m^2/s, m/s^2).
+
+    Examples
+    --------
+    >>> damping_validity("sphere", 0.1016, 0.6 * 0.2032, 1.004e-6, 9.81) is None
+    True
+    """
     hr = depth / radius
-    x = 1.84 * hr
-    bracket = 1.0 + (0.318 / math.sinh(x)) * (1.0 + (1.0 - hr) / math.cosh(x))
-    return 4.98 / (2.0 * math.pi) * math.sqrt(viscosity) * radius**-0.75 * gravity**-0.25 * bracket
+    factor = (_sphere_factor if shape == "sphere" else _cylinder_factor)(hr)
+    why = []
+    if factor > DEPTH_FACTOR_LIMIT:  # both factors are 1 half full (sphere), deep (cylinder)
+        where = f"fill {100 * depth / (2 * radius):.3g} % of the height" if shape == "sphere" \
+            else f"depth {hr:.3g} radii"
+        why.append(f"{where}: its depth factor is {factor:.3g} times the "
+                   f"{'half-full' if shape == 'sphere' else 'deep-liquid'} value, used up to "
+                   f"{DEPTH_FACTOR_LIMIT:g} times")
+    if shape == "sphere":
+        number = viscosity / ((2 * radius) ** 1.5 * math.sqrt(gravity))
+        lo, hi = SPHERE_NUMBER_RANGE
+        if not lo <= number <= hi:
+            why.append(f"nu/(d^1.5 g^0.5) = {number:.3g}, outside its data ({lo:g} to {hi:g})")
+    if not why:
+        return None
+    return (f"damping_ratio is outside the validity range of the SP-106 {shape} correlation ("
+            + "; ".join(why) + "): an extrapolation, not a prediction")

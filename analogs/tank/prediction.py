@@ -32,11 +32,14 @@ from typing import Any, Union
 
 from . import _fem, _legacy, _ritz
 from ._modes import RawModes
-from .damping import cylinder_damping, sphere_damping
+from .damping import cylinder_damping, damping_validity, sphere_damping
 from .geometry import WATER, Capsule, Cylinder, Liquid, Sphere, Tank
 
-__all__ = ["Exact", "FiniteElements", "FixedMassPrediction", "Legacy", "Ritz", "SloshMode",
-           "TankPrediction", "predict"]
+__all__ = ["MAX_MODES", "Exact", "FiniteElements", "FixedMassPrediction", "Legacy", "Ritz",
+           "SloshMode", "TankPrediction", "predict"]
+
+#: Most slosh modes :func:`predict` computes.
+MAX_MODES = 6
 
 
 # -- solver strategies ---------------------------------------------------------------------
@@ -228,20 +231,25 @@ class TankPrediction:
 
 
 # -- the problem ---------------------------------------------------------------------------
-def _damping(tank: Tank, depth: float, liquid: Liquid, gravity: float) -> float:
+def _damping(tank: Tank, depth: float, liquid: Liquid, gravity: float) -> tuple[float, str | None]:
+    """The damping ratio and, when the correlation does not hold there, why."""
     nu = liquid.viscosity
     if isinstance(tank, Sphere):
-        return sphere_damping(tank.radius, depth, nu, gravity)
-    if isinstance(tank, Cylinder):
-        return cylinder_damping(tank.radius, depth, nu, gravity)
-    if isinstance(tank, Capsule):
+        shape, radius, h = "sphere", tank.radius, depth
+    elif isinstance(tank, Cylinder):
+        shape, radius, h = "cylinder", tank.radius, depth
+    elif isinstance(tank, Capsule):
         a, c = tank.radius, tank.cylinder_length
         if depth <= a:  # bottom dome: a sphere of the same radius at this depth
-            return sphere_damping(a, depth, nu, gravity)
-        if depth >= a + c:  # top dome
-            return sphere_damping(a, depth - c, nu, gravity)
-        return cylinder_damping(a, depth, nu, gravity)
-    return float("nan")
+            shape, radius, h = "sphere", a, depth
+        elif depth >= a + c:  # top dome
+            shape, radius, h = "sphere", a, depth - c
+        else:
+            shape, radius, h = "cylinder", a, depth
+    else:
+        return float("nan"), None
+    zeta = (sphere_damping if shape == "sphere" else cylinder_damping)(radius, h, nu, gravity)
+    return zeta, damping_validity(shape, radius, h, nu, gravity)
 
 
 def _solver(method: str | Solver) -> Solver:
@@ -297,8 +305,8 @@ def predict(tank: Tank, *, fill: float | None = None, volume_fill: float | None 
     gravity_ = float(gravity) if isinstance(gravity, (int, float)) else float("nan")
     if not (math.isfinite(gravity_) and gravity_ > 0):
         raise ValueError(f"`gravity` must be a positive acceleration in m/s^2; got {gravity!r}.")
-    if not (isinstance(modes, int) and 1 <= modes <= 6):
-        raise ValueError(f"`modes` must be an integer from 1 to 6; got {modes!r}.")
+    if not (isinstance(modes, int) and 1 <= modes <= MAX_MODES):
+        raise ValueError(f"`modes` must be an integer from 1 to {MAX_MODES}; got {modes!r}.")
     if not isinstance(liquid, Liquid):
         raise ValueError(f"`liquid` must be a Liquid(density=..., viscosity=...); got {liquid!r}.")
     solver = _solver(method)
@@ -313,7 +321,7 @@ def predict(tank: Tank, *, fill: float | None = None, volume_fill: float | None 
     volume = tank.volume(depth)
     m_liq = rho * volume
     z_cg = tank.centroid_height(depth)
-    zeta = _damping(tank, depth, liquid, g)
+    zeta, validity = _damping(tank, depth, liquid, g)
     out = []
     for n in range(modes):
         lam, a, b = raw.lam[n], raw.a[n], raw.b[n]
@@ -333,6 +341,8 @@ def predict(tank: Tank, *, fill: float | None = None, volume_fill: float | None 
                      "frequency, lowers the slosh mass and adds damping - estimate them from data")
     if not math.isfinite(zeta):
         notes.append("no damping correlation for a general profile: damping_ratio is nan")
+    if validity:
+        notes.append(validity)
     if isinstance(solver, Legacy):
         notes.append("legacy Lomen basis (SLOSH code conventions): not converged above half full")
     return TankPrediction(

@@ -24,82 +24,13 @@ from analogs.errors import InputError
 from derive import DerivedModel, Excitation, NoExcitation, rk4_step
 
 from ..executor import Executor, LocalExecutor, chunks
+from ..fitting.params_io import Fit, read_fit
 
 __all__ = ["Fit", "read_fit", "draw_parameters", "MonteCarlo", "MonteCarloResult",
            "monte_carlo", "derived_quantities", "PERCENTILES"]
 
 #: Percentiles of the envelopes and derived-quantity summaries.
 PERCENTILES = (2.5, 5.0, 50.0, 95.0, 97.5)
-
-
-@dataclass(frozen=True)
-class Fit:
-    """What Monte Carlo and export need from the JSON that ``slosh fit`` writes."""
-
-    path: Path | None
-    model_spec: str
-    case: str | None
-    values: Mapping[str, float]
-    units: Mapping[str, str]
-    lower: Mapping[str, float]
-    upper: Mapping[str, float]
-    estimated: tuple[str, ...]
-    covariance_names: tuple[str, ...]
-    covariance: np.ndarray = field(repr=False)
-
-
-def _number(v, default: float) -> float:
-    if v is None:
-        return default
-    return float(v)
-
-
-def read_fit(path: str | Path) -> Fit:
-    """Read a fit result (the JSON of ``slosh fit``).
-
-    Raises
-    ------
-    ValueError
-        Naming the file and every problem: missing keys, a covariance that is not square,
-        names that are not parameters.
-    """
-    from ..fitting.params_io import read_json
-
-    path = Path(path)
-    data = read_json(path, "fit file")
-    problems = []
-    params = data.get("parameters") if isinstance(data, dict) else None
-    if not isinstance(params, dict) or not params:
-        raise InputError(f"{path}: expected a fit result with a \"parameters\" object")
-    spec = data.get("model_spec") or ",".join(data.get("model") or [])
-    if not spec:
-        problems.append("missing \"model_spec\" (e.g. \"fixed,p1\")")
-    values, units, lower, upper, estimated = {}, {}, {}, {}, []
-    for name, entry in params.items():
-        if not isinstance(entry, dict) or not isinstance(entry.get("value"), (int, float)):
-            problems.append(f"parameters.{name}: expected {{\"value\": number, ...}}")
-            continue
-        values[name] = float(entry["value"])
-        units[name] = str(entry.get("unit", ""))
-        lower[name] = _number(entry.get("lower"), -math.inf)
-        upper[name] = _number(entry.get("upper"), math.inf)
-        if entry.get("estimated", False):
-            estimated.append(name)
-    cov = data.get("covariance") or {}
-    names = tuple(cov.get("parameters") or ())
-    matrix = np.asarray(cov.get("matrix") if cov.get("matrix") is not None else np.zeros((0, 0)),
-                        float)
-    if names and matrix.shape != (len(names), len(names)):
-        problems.append(f"covariance.matrix must be {len(names)}x{len(names)} "
-                        f"(one row per covariance.parameters), found shape {matrix.shape}")
-    unknown = [n for n in names if n not in values]
-    if unknown:
-        problems.append(f"covariance.parameters not in parameters: {', '.join(unknown)}")
-    if problems:
-        raise InputError(f"{path}: " + "; ".join(problems))
-    return Fit(path=path, model_spec=spec, case=data.get("case"), values=values, units=units,
-               lower=lower, upper=upper, estimated=tuple(estimated), covariance_names=names,
-               covariance=matrix)
 
 
 def draw_parameters(fit: Fit, samples: int, *, seed: int | None = 0,
@@ -367,6 +298,7 @@ class MonteCarlo:
         names = self._outputs()
         for n in names:
             dm.output_index(n)
+        _check_memory(samples, len(names), np.size(self.time))
         unknown = [n for n in self.fit.covariance_names if n not in dm.parameter_names]
         if unknown:
             raise InputError(f"covariance parameters {', '.join(unknown)} are not parameters of "
@@ -401,6 +333,24 @@ class MonteCarlo:
             seconds=_time.perf_counter() - start,
             executor=f"{type(executor).__name__} ({executor.workers} worker"
                      f"{'s' if executor.workers > 1 else ''})")
+
+
+#: Copies of the simulated outputs held at once (results, their stack, percentile sorting).
+_OUTPUT_COPIES = 3
+
+
+def _check_memory(samples: int, outputs: int, n_time: int) -> None:
+    """Refuse a run whose simulated outputs would not fit the memory budget."""
+    from ..data.budget import BUDGET_VARIABLE, memory_budget, size_text
+
+    need = _OUTPUT_COPIES * 8 * samples * outputs * n_time
+    budget = memory_budget()
+    if need > budget:
+        most = budget // (_OUTPUT_COPIES * 8 * outputs * n_time)
+        raise InputError(f"{samples} draws of {outputs} output(s) over {n_time} time samples "
+                         f"need about {size_text(need)}, over the memory budget of "
+                         f"{size_text(budget)} (set {BUDGET_VARIABLE} to change it): use at "
+                         f"most {most} draws, or a shorter or decimated case")
 
 
 def monte_carlo(derived: DerivedModel, time: np.ndarray, excitation: Excitation | None,

@@ -27,21 +27,41 @@ def main(argv: list[str] | None = None) -> int:
     """Entry point of the ``slosh`` console script; returns the exit status.
 
     Errors in what the user gave (:class:`analogs.errors.InputError`: case and fit files,
-    models, parameter values, options), file-system errors and missing optional libraries
-    are printed as one line (status 2); anything else is a defect and shows its traceback.
+    models, parameter values, options, output paths), file-system errors and missing
+    optional libraries are printed as one line (status 2); anything else is a defect and
+    shows its traceback. SIGINT and SIGTERM abort the command (:mod:`estimate.interrupts`):
+    nothing is written, one line says so, and the status is 130 or 143.
     """
     for var in ("OMP_NUM_THREADS", "OPENBLAS_NUM_THREADS", "MKL_NUM_THREADS"):
         os.environ.setdefault(var, "1")
     args = _parser().parse_args(argv)
     from analogs.errors import InputError, MissingDependency
 
-    try:
-        status = args.run(args)
-    except (InputError, MissingDependency) as err:
-        return _fail(args.command, str(err))
-    except OSError as err:
-        return _fail(args.command, _os_message(err))
+    from ..interrupts import Interrupted, handled, received
+
+    with handled(f"slosh {args.command}"):
+        try:
+            status = args.run(args)
+        except Interrupted as err:
+            return _interrupted(args.command, err, written=False)
+        except (InputError, MissingDependency) as err:
+            return _fail(args.command, str(err))
+        except OSError as err:
+            return _fail(args.command, _os_message(err))
+        except Exception:
+            if received() is None:  # a defect, not an interrupt that some code wrapped
+                raise
+            return _interrupted(args.command, Interrupted(received()), written=False)
+        if received() is not None:  # arrived while the outputs were being renamed
+            return _interrupted(args.command, Interrupted(received()), written=True)
     return int(status or 0)
+
+
+def _interrupted(command: str, err, *, written: bool) -> int:
+    what = ("while finishing; the output files it names are complete" if written else
+            "nothing was written; existing output files are unchanged")
+    print(f"slosh {command}: interrupted by {err.signal_name}: {what}", file=sys.stderr)
+    return err.exit_status
 
 
 def _fail(command: str, message: str) -> int:

@@ -3,10 +3,9 @@
 from __future__ import annotations
 
 import argparse
-import json
-from pathlib import Path
 
-from ._outputs import refuse_existing
+from ..outputs import Outputs, json_text
+from ._cases import load_cases
 
 __all__ = ["add_parser"]
 
@@ -26,16 +25,23 @@ def add_parser(sub: argparse._SubParsersAction) -> None:
 
 
 def run(args: argparse.Namespace) -> int:
-    from ..data import load_case
-    from ..diagnosis.report import _json_default, summary, write_report
+    import sys
+
+    from ..diagnosis.report import REPORT_FILES, summary, write_report
     from ..diagnosis.search import diagnose
 
-    out = Path(args.json_out)
-    refuse_existing([out], args.overwrite)
-    d = diagnose([load_case(c) for c in args.cases])
-    out.write_text(json.dumps(d.to_dict(), indent=2, default=_json_default))
-    if args.report:
-        write_report(d, args.report, overwrite=args.overwrite)
+    outputs = Outputs(overwrite=args.overwrite, inputs=args.cases)
+    outputs.file("--json", args.json_out).folder("--report", args.report, REPORT_FILES).check()
+    cases, notes = load_cases(args.cases, prediction=True)
+    for w in notes:
+        print(f"warning: {w}", file=sys.stderr)
+    d = diagnose(cases)
+    data = d.to_dict()
+    data["notes"] = [*notes, *data.get("notes", ())]
+    with outputs.writing() as paths:
+        paths["--json"].write_text(json_text(data))
+        if args.report:
+            write_report(d, paths["--report"], overwrite=True)
     text = summary(d)
     print(text.split("## What the baseline gets wrong")[0].strip())
     return 0

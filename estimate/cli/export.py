@@ -8,13 +8,14 @@ from __future__ import annotations
 
 import argparse
 import math
-import sys
 from pathlib import Path
 from types import SimpleNamespace
 
 from analogs import Model
 from analogs.errors import InputError
 from analogs.vehicle import VehicleFrame
+
+from ..outputs import Outputs
 
 __all__ = ["add_parser", "run", "export_model"]
 
@@ -75,14 +76,20 @@ def export_model(spec: str, values: dict[str, float], *, interface: str = "rig",
 
 
 def _spec_of(path: Path) -> str | None:
-    import json
+    """The model specification a fit file names, or None (a flat map of values)."""
+    from ..fitting.params_io import read_json
 
-    try:
-        data = json.loads(path.read_text())
-    except (OSError, ValueError):
+    data = read_json(path, "fit file")
+    if not isinstance(data, dict):
         return None
-    if isinstance(data, dict):
-        return data.get("model_spec") or (",".join(data["model"]) if data.get("model") else None)
+    spec, model = data.get("model_spec"), data.get("model")
+    if spec is not None and not isinstance(spec, str):
+        raise InputError(f"{path}: `model_spec`: expected a string such as \"fixed,p1\", "
+                         f"found {spec!r}")
+    if spec:
+        return spec
+    if isinstance(model, list) and model and all(isinstance(m, str) for m in model):
+        return ",".join(model)
     return None
 
 
@@ -104,7 +111,7 @@ def _assignments(items: list[str]) -> dict[str, float]:
 def run(args: argparse.Namespace) -> int:
     """Run ``slosh export``; returns the exit status."""
     from derive import derive
-    from derive.export_c import export_c, has_c_compiler
+    from derive.export_c import c_export_files, export_c, has_c_compiler
 
     from ..data.models import BASELINE
     from ..fitting.params_io import read_params
@@ -118,30 +125,38 @@ def run(args: argparse.Namespace) -> int:
         raise InputError("`--planar` applies to `--interface vehicle` only")
     values = read_params(args.fit) | _assignments(args.set)
     spec = args.model or _spec_of(Path(args.fit)) or BASELINE
+    outputs = Outputs(overwrite=args.overwrite, inputs=[args.fit])
+    outputs.folder("--out", args.out, [*c_export_files(args.name).values(), "simulate"])
+    outputs.file("--fmu", args.fmu).check()
     model, used = export_model(spec, values, interface=args.interface, planar=args.planar)
     dm = derive(model)
     pvec = dm.parameter_vector(used)
     unset = [n for n, v in zip(dm.parameter_names, pvec) if math.isnan(v)]
+    with outputs.writing() as paths:
+        if args.out:
+            ex = export_c(dm, paths["--out"], used, substeps=args.substeps, name=args.name,
+                          overwrite=True)
+            if not args.no_build and has_c_compiler():
+                try:
+                    ex.build()
+                except RuntimeError as err:
+                    raise InputError(f"--out {args.out}: {err}; pass --no-build to write the "
+                                     "sources without compiling them") from None
+        if args.fmu:
+            from derive.fmu import export_fmu
+
+            export_fmu(dm, paths["--fmu"], used, substeps=args.substeps, max_step=args.step,
+                       name=args.name, overwrite=True)
     if args.out:
-        ex = export_c(dm, args.out, used, substeps=args.substeps, name=args.name,
-                      overwrite=args.overwrite)
-        print(f"wrote C export of {spec} ({args.interface} interface) to {ex.folder}: "
+        print(f"wrote C export of {spec} ({args.interface} interface) to {args.out}: "
               f"{ex.header.name}, {', '.join(s.name for s in ex.sources)}, {ex.driver.name}, "
               f"{ex.makefile.name}, {ex.parameters_csv.name}")
         print(f"  states: {', '.join(ex.states)}")
         print(f"  inputs: {', '.join(ex.inputs) or '(none)'}")
-        if not args.no_build and has_c_compiler():
-            try:
-                print(f"  built {ex.build()}")
-            except RuntimeError as err:
-                print(f"slosh export: error: {err}", file=sys.stderr)
-                return 2
+        if (Path(args.out) / "simulate").exists() and not args.no_build:
+            print(f"  built {Path(args.out) / 'simulate'}")
     if args.fmu:
-        from derive.fmu import export_fmu
-
-        fmu = export_fmu(dm, args.fmu, used, substeps=args.substeps, max_step=args.step,
-                         name=args.name, overwrite=args.overwrite)
-        print(f"wrote FMU {fmu}")
+        print(f"wrote FMU {args.fmu}")
     if unset:
         print(f"  note: no value for {', '.join(unset)}: outputs that need them are NaN in C "
               "and left out of the FMU")

@@ -3,10 +3,9 @@
 from __future__ import annotations
 
 import argparse
-import json
-from pathlib import Path
 
-from ._outputs import refuse_existing
+from ..outputs import Outputs, json_text
+from ._cases import load_cases
 
 __all__ = ["add_parser"]
 
@@ -38,15 +37,17 @@ def add_parser(sub: argparse._SubParsersAction) -> None:
 def run(args: argparse.Namespace) -> int:
     import sys
 
-    from ..data import load_case
     from ..data.models import BASELINE, model_from_spec
     from ..fitting.nlp import fit
     from ..fitting.problem import FitProblem
     from ..fitting.transcription import Collocation, MultipleShooting
 
-    refuse_existing([args.json_out, args.plot], args.overwrite)
-    cases = [load_case(c) for c in args.cases]
-    spec = args.model or BASELINE
+    outputs = Outputs(overwrite=args.overwrite, inputs=args.cases)
+    outputs.file("--json", args.json_out).file("--plot", args.plot).check()
+    cases, notes = load_cases(args.cases, prediction=True)
+    for w in notes:  # before the fit, which starts from [prediction]
+        print(f"warning: {w}", file=sys.stderr)
+    spec = BASELINE if args.model is None else args.model
     model = model_from_spec(spec, cases[0])
     mode = args.input or ("filtered" if args.cost == "abs" else "estimated")
     problem = FitProblem.build(cases, model, input=mode)
@@ -64,12 +65,14 @@ def run(args: argparse.Namespace) -> int:
             print(f"  note: {c}")
     for w in result.warnings:
         print(f"warning: {w}", file=sys.stderr)
-    if args.json_out:
-        data = result.to_dict()
-        data["model_spec"] = spec
-        Path(args.json_out).write_text(json.dumps(data, indent=2))
-    if args.plot:
-        from ..fitting.plots import plot_fit
+    with outputs.writing() as paths:
+        if args.json_out:
+            data = result.to_dict()
+            data["model_spec"] = spec
+            data["warnings"] = [*notes, *data.get("warnings", ())]
+            paths["--json"].write_text(json_text(data))
+        if args.plot:
+            from ..fitting.plots import plot_fit
 
-        plot_fit(result, args.plot)
+            plot_fit(result, paths["--plot"])
     return 0 if result.converged else 1

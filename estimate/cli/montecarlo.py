@@ -7,12 +7,11 @@ Wire-up: ``estimate.cli`` calls :func:`add_parser` on its subparsers and dispatc
 from __future__ import annotations
 
 import argparse
-import json
 from pathlib import Path
 
 from analogs.errors import InputError
 
-from ._outputs import refuse_existing
+from ..outputs import Outputs, json_text
 
 __all__ = ["add_parser", "run"]
 
@@ -55,8 +54,11 @@ def run(args: argparse.Namespace) -> int:
     if args.samples < 1:
         raise InputError(f"--samples must be at least 1, got {args.samples}")
     out = Path(args.out)
-    files = [out / "montecarlo.json", out / "envelope.png"]
-    refuse_existing(files, args.overwrite)
+    files = {"montecarlo.json": out / "montecarlo.json", "envelope.png": out / "envelope.png"}
+    outputs = Outputs(overwrite=args.overwrite, inputs=[args.fit, args.case])
+    for name, path in files.items():
+        outputs.file(f"--out {name}", path, new_folder=True)
+    outputs.check()
     fit = read_fit(args.fit)
     case = load_case(args.case)
     exp = experiment(case, model_from_spec(args.model or fit.model_spec, case))
@@ -64,10 +66,10 @@ def run(args: argparse.Namespace) -> int:
         res = monte_carlo(exp.derived, case.time, exp.excitation, fit, args.samples,
                           fixed=exp.fixed, seed=args.seed, executor=ex,
                           batch_size=args.batch_size)
-    out.mkdir(parents=True, exist_ok=True)
     data = {"fit": str(args.fit), "case": str(args.case), **res.to_json()}
-    files[0].write_text(json.dumps(data, indent=1) + "\n")
-    res.plot(files[1])
+    with outputs.writing() as paths:
+        paths["--out montecarlo.json"].write_text(json_text(data, indent=1))
+        res.plot(paths["--out envelope.png"])
     print(res.report())
-    print(f"wrote {files[0]} and {files[1]}")
+    print(f"wrote {files['montecarlo.json']} and {files['envelope.png']}")
     return 0

@@ -38,14 +38,13 @@ File format (SI units; see ``examples/spacecraft.toml``)::
 from __future__ import annotations
 
 import argparse
-import json
 import sys
 import tomllib
 from pathlib import Path
 
 from analogs.errors import InputError
 
-from ._outputs import refuse_existing
+from ..outputs import Outputs, json_text
 
 __all__ = ["add_parser", "run", "load_spacecraft"]
 
@@ -200,20 +199,20 @@ def run(args: argparse.Namespace) -> int:
     """Run ``slosh ntc``; returns the exit status."""
     from ..analysis.ntc import nutation_time_constant
 
-    refuse_existing([args.json], args.overwrite)
+    outputs = Outputs(overwrite=args.overwrite, inputs=[args.spacecraft])
+    outputs.file("--json", args.json).check()
     model, params, options = load_spacecraft(args.spacecraft)
     ntc = nutation_time_constant(model, params, **options)
     print(f"{args.spacecraft}: {model!r}")
     print(ntc.report())
-    if args.json:
-        out = {"ntc_simulated_s": ntc.simulated, "ntc_linearized_s": ntc.linearized,
-               "growth_rate_simulated_per_s": ntc.growth_rate_simulated,
-               "growth_rate_linearized_per_s": ntc.growth_rate_linearized,
-               "nutation_frequency_rad_s": ntc.nutation_frequency,
-               "relative_difference": ntc.relative_difference, "grows": ntc.grows}
-        with open(args.json, "w", encoding="utf-8") as fh:
-            json.dump(out, fh, indent=2)
-            fh.write("\n")
+    out = {"ntc_simulated_s": ntc.simulated, "ntc_linearized_s": ntc.linearized,
+           "growth_rate_simulated_per_s": ntc.growth_rate_simulated,
+           "growth_rate_linearized_per_s": ntc.growth_rate_linearized,
+           "nutation_frequency_rad_s": ntc.nutation_frequency,
+           "relative_difference": ntc.relative_difference, "grows": ntc.grows}
+    with outputs.writing() as paths:
+        if args.json:
+            paths["--json"].write_text(json_text(out))
     if ntc.relative_difference > 0.02:
         print("warning: the two methods differ by more than 2 %; simulate longer "
               "([ntc] duration) or with a smaller initial_rate", file=sys.stderr)

@@ -3,9 +3,11 @@
 from __future__ import annotations
 
 import argparse
-from pathlib import Path
+import sys
 
-from ._outputs import refuse_existing
+from analogs.errors import InputError
+
+from ..outputs import Outputs
 
 __all__ = ["add_parser"]
 
@@ -41,18 +43,30 @@ def run(args: argparse.Namespace) -> int:
     from ..data.models import BASELINE, model_from_spec
     from ..fitting.params_io import fitted_initial_state, read_params
 
-    out = Path(args.out)
-    refuse_existing([out], args.overwrite)
+    outputs = Outputs(overwrite=args.overwrite, inputs=[args.case, args.params])
+    outputs.file("--out", args.out).check()
     case = load_case(args.case)
     params = read_params(args.params)
     x0 = fitted_initial_state(args.params, case) if case.test.initial_state == "free" else None
-    exp = experiment(case, model_from_spec(args.model or BASELINE, case))
+    exp = experiment(case, model_from_spec(BASELINE if args.model is None else args.model, case))
+    for name, value in exp.fixed.items():  # the rig is the case file's, not the fit's
+        given = params.pop(name, value)
+        if given != value:
+            print(f"note: {args.params} gives {name} = {given:.6g}; the case file's "
+                  f"{value:.6g} is used", file=sys.stderr)
     integrator = RK4() if args.integrator == "rk4" else Adaptive()
     sim = exp.simulate(params, integrator=integrator, x0=x0)
     # every channel the case measures; the lateral force keeps its historical name
     columns = {"time": sim.time, **({"force": sim.output("force_x")} if exp.channels == ("force_x",)
                                     else {c: sim.output(c) for c in exp.channels})}
-    np.savetxt(out, np.column_stack(list(columns.values())), delimiter=",",
-               header=",".join(columns), comments="", fmt="%.12g")
-    print(f"wrote {out} ({sim.time.size} samples, model {', '.join(exp.model.names)})")
+    table = np.column_stack(list(columns.values()))
+    bad = np.flatnonzero(~np.all(np.isfinite(table), axis=1))
+    if bad.size:
+        raise InputError(f"the simulation is not finite from t = {sim.time[bad[0]]:.6g} s on "
+                         f"({bad.size} of {sim.time.size} rows): check the parameter values in "
+                         f"{args.params}; {args.out} was not written")
+    with outputs.writing() as paths:
+        np.savetxt(paths["--out"], table, delimiter=",", header=",".join(columns), comments="",
+                   fmt="%.12g")
+    print(f"wrote {args.out} ({sim.time.size} samples, model {', '.join(exp.model.names)})")
     return 0

@@ -7,13 +7,11 @@ Wire-up: ``estimate.cli`` calls :func:`add_parser` on its subparsers and dispatc
 from __future__ import annotations
 
 import argparse
-import json
-import sys
 
 from analogs.errors import InputError
 from analogs.tank import Capsule, Cylinder, Liquid, Sphere, predict
 
-from ._outputs import refuse_existing
+from ..outputs import Outputs, json_text
 
 __all__ = ["add_parser", "run"]
 
@@ -87,21 +85,20 @@ def _plot(args: argparse.Namespace, tank, liquid: Liquid, path: str) -> None:
 
 def run(args: argparse.Namespace) -> int:
     """Run ``slosh tank``; returns the exit status (2 on bad input)."""
-    refuse_existing([args.json, args.plot], args.overwrite)
+    outputs = Outputs(overwrite=args.overwrite)
+    outputs.file("--json", args.json).file("--plot", args.plot).check()
     try:
         tank = _tank(args)
         liquid = Liquid(density=args.density, viscosity=args.viscosity, name="liquid")
         pred = predict(tank, fill=args.fill, volume_fill=args.volume_fill, liquid=liquid,
                        gravity=args.gravity, method=args.method, modes=args.modes,
                        diaphragm=args.diaphragm)
-    except ValueError as err:
-        print(f"slosh tank: error: {err}", file=sys.stderr)
-        return 2
+    except ValueError as err:  # the tank module's checks of its arguments
+        raise InputError(str(err)) from None
     print(pred.report())
-    if args.json:
-        with open(args.json, "w", encoding="utf-8") as fh:
-            json.dump(pred.to_dict(), fh, indent=2)
-            fh.write("\n")
-    if args.plot:
-        _plot(args, tank, liquid, args.plot)
+    with outputs.writing() as paths:
+        if args.json:
+            paths["--json"].write_text(json_text({**pred.to_dict(), "notes": list(pred.notes)}))
+        if args.plot:
+            _plot(args, tank, liquid, paths["--plot"])
     return 0

@@ -3,12 +3,14 @@
 from __future__ import annotations
 
 import csv
+from collections.abc import Iterator
 from pathlib import Path
 from typing import Any
 
 import numpy as np
 
-from .case import MIN_SAMPLES, SPINNING_CHANNELS, TIME_STEP_RTOL
+from .budget import decimation_hint, max_samples
+from .case import MIN_DURATION, MIN_SAMPLES, SPINNING_CHANNELS, TIME_STEP_RTOL
 
 __all__ = ["read_csv"]
 
@@ -23,29 +25,73 @@ def _rows_text(lines: list[int]) -> str:
     return f"line{'s' if len(lines) != 1 else ''} {shown}{more}"
 
 
+def _values_text(found: list[tuple[int, str]]) -> str:
+    shown = ", ".join(f"line {ln} `{txt}`" for ln, txt in found[:_MAX_LISTED_ROWS])
+    more = f" and {len(found) - _MAX_LISTED_ROWS} more" if len(found) > _MAX_LISTED_ROWS else ""
+    return shown + more
+
+
+def _count_lines(path: Path) -> int:
+    """Lines in ``path`` ending in LF, CR LF or CR, counted in 1 MiB chunks (the number of
+    its rows unless line ends are mixed)."""
+    lf = cr = 0
+    last = b"\n"
+    with path.open("rb") as fh:
+        while chunk := fh.read(2**20):
+            lf += chunk.count(b"\n")
+            cr += chunk.count(b"\r")
+            last = chunk[-1:]
+    return max(lf, cr) + (last not in (b"\n", b"\r"))
+
+
+def _python_only(text: str) -> bool:
+    """Whether ``text``, which ``float`` reads, is a number in Python's syntax only: digit
+    separators (``1_000``) and non-ASCII digits, which no other CSV reader accepts."""
+    return "_" in text or not text.isascii()
+
+
 def read_csv(path: Path, excitation: str | None, problems: list[str],
               rig_kind: str | None = "lateral") -> tuple[Any, ...] | None:
     """Read and check the CSV; append problems; return (time, displacement, force, columns)
-    or None (``columns``: the non-time columns of a spinning-rig CSV, else empty)."""
+    or None (``columns``: the non-time columns of a spinning-rig CSV, else empty).
+
+    The file is streamed: a record with more samples than the memory budget allows
+    (:mod:`estimate.data.budget`) is refused before its arrays are allocated. A UTF-8 byte
+    order mark (Excel's "CSV UTF-8") is accepted.
+    """
     name = path.name
     try:
-        with path.open("r", newline="", encoding="utf-8") as fh:
-            reader = csv.reader(fh)
-            rows = [(reader.line_num, row) for row in reader]
+        n_lines = _count_lines(path)
+        if n_lines - 1 > max_samples():
+            problems.append(f"{name}: rows: {n_lines - 1} samples; {decimation_hint(n_lines - 1)}")
+            return None
+        with path.open("r", newline="", encoding="utf-8-sig") as fh:
+            return _read_rows(csv.reader(fh), n_lines, name, excitation, problems, rig_kind)
     except OSError as exc:
         problems.append(f"{name}: cannot read the CSV file ({exc.strerror or exc})")
         return None
     except (UnicodeDecodeError, csv.Error) as exc:
         problems.append(f"{name}: not a readable UTF-8 CSV file ({exc})")
         return None
-    rows = [(n, r) for n, r in rows if r and any(c.strip() for c in r)]  # skip blank lines
+
+
+def _rows(reader) -> Iterator[tuple[int, list[str]]]:
+    for row in reader:
+        if row and any(c.strip() for c in row):  # skip blank lines
+            yield reader.line_num, row
+
+
+def _read_rows(reader, n_lines: int, name: str, excitation: str | None, problems: list[str],
+               rig_kind: str | None) -> tuple[Any, ...] | None:
+    rows = _rows(reader)
+    first = next(rows, None)
     spinning = rig_kind == "spinning"
     spin_header = "`" + ",".join(("time",) + SPINNING_CHANNELS) + "`"
-    if not rows:
+    if first is None:
         expected = spin_header if spinning else "`time,displacement,force`"
         problems.append(f"{name}: header: expected {expected}, found an empty file")
         return None
-    header_line, header = rows[0]
+    header_line, header = first
     names = tuple(c.strip() for c in header)
     has_disp = False
     if spinning:
@@ -82,12 +128,23 @@ def read_csv(path: Path, excitation: str | None, problems: list[str],
             "use `excitation = \"crank\"` with a `[rig.crank]` table otherwise)")
 
     ncol = len(names)
-    data = np.full((len(rows) - 1, ncol), np.nan)
-    lines = np.empty(len(rows) - 1, dtype=int)
+    limit = max_samples()
+    data = np.full((min(max(n_lines - 1, 16), limit), ncol), np.nan)
+    lines = np.empty(data.shape[0], dtype=int)
     bad_fields: list[str] = []
     skip_lines: set[int] = set()  # rows already reported; not reported again as NaN
     bad_numbers: dict[str, list[tuple[int, str]]] = {c: [] for c in names}
-    for i, (line, row) in enumerate(rows[1:]):
+    python_only: dict[str, list[tuple[int, str]]] = {c: [] for c in names}
+    i = -1
+    for i, (line, row) in enumerate(rows):
+        if i == data.shape[0]:  # mixed line ends: more rows than counted
+            if i >= limit:
+                problems.append(f"{name}: rows: more than {limit} samples; "
+                                f"{decimation_hint(limit + 1)}")
+                return None
+            grow = min(2 * i, limit)
+            data = np.vstack([data, np.full((grow - i, ncol), np.nan)])
+            lines = np.concatenate([lines, np.empty(grow - i, dtype=int)])
         lines[i] = line
         if len(row) != ncol:
             bad_fields.append(f"line {line} ({len(row)} fields)")
@@ -98,6 +155,10 @@ def read_csv(path: Path, excitation: str | None, problems: list[str],
                 data[i, j] = float(text)
             except ValueError:
                 bad_numbers[names[j]].append((line, text))
+                continue
+            if _python_only(text):
+                python_only[names[j]].append((line, text))
+    data, lines = data[:i + 1], lines[:i + 1]
     if bad_fields:
         shown = "; ".join(bad_fields[:_MAX_LISTED_ROWS])
         more = (f" and {len(bad_fields) - _MAX_LISTED_ROWS} more"
@@ -107,10 +168,13 @@ def read_csv(path: Path, excitation: str | None, problems: list[str],
     for j, col in enumerate(names):
         bad = bad_numbers[col]
         if bad:
-            shown = ", ".join(f"line {ln} `{txt}`" for ln, txt in bad[:_MAX_LISTED_ROWS])
-            more = f" and {len(bad) - _MAX_LISTED_ROWS} more" if len(bad) > _MAX_LISTED_ROWS else ""
             problems.append(f"{name}: column `{col}`: expected numbers, found {len(bad)} "
-                            f"non-numeric value(s): {shown}{more}")
+                            f"non-numeric value(s): {_values_text(bad)}")
+        odd = python_only[col]
+        if odd:
+            problems.append(f"{name}: column `{col}`: expected plain numbers such as 1000 or "
+                            f"1e3, found {len(odd)} value(s) with digit separators or non-ASCII "
+                            f"digits, which only Python reads: {_values_text(odd)}")
         skip = skip_lines | {ln for ln, _ in bad}
         nonfinite = [int(lines[i]) for i in np.flatnonzero(~np.isfinite(data[:, j]))
                      if int(lines[i]) not in skip]
@@ -131,6 +195,10 @@ def read_csv(path: Path, excitation: str | None, problems: list[str],
             where = [int(lines[i + 1]) for i in nonincreasing]
             problems.append(f"{name}: column `time`: expected strictly increasing times, found "
                             f"{nonincreasing.size} decrease(s) or repeat(s) at {_rows_text(where)}")
+        elif n >= MIN_SAMPLES and t[-1] - t[0] < MIN_DURATION:
+            problems.append(f"{name}: column `time`: expected a record of at least "
+                            f"{MIN_DURATION:g} s (times in seconds), found {t[-1] - t[0]:.3g} s "
+                            f"({n} samples at a step of {float(np.median(dt)):.3g} s)")
         else:
             step = float(np.median(dt))
             off = np.flatnonzero(np.abs(dt - step) > TIME_STEP_RTOL * step)

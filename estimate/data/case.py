@@ -94,6 +94,9 @@ Validation limits
   (a dropped sample is a 100% step error).
 * At least :data:`MIN_SAMPLES` (50) samples: fewer cannot hold a few periods of a 1-5 Hz drive at
   100 Hz sampling, nor the padding that zero-phase filters and Welch spectra need.
+* At least :data:`MIN_DURATION` (0.1 s): a shorter record cannot hold one period of a slosh
+  mode (those of test tanks lie below about 10 Hz); a record of nanoseconds is a time column
+  in the wrong unit, and would ask the 10 Hz low-pass filter for a design at 1e12 Hz sampling.
 * CSV problems name the line of the file (the header is line 1).
 """
 
@@ -113,6 +116,7 @@ __all__ = [
     "KNOWN_INITIAL_STATES",
     "KNOWN_RIGS",
     "KNOWN_SHAPES",
+    "MIN_DURATION",
     "MIN_SAMPLES",
     "TIME_STEP_RTOL",
     "Case",
@@ -146,6 +150,8 @@ KNOWN_SHAPES: tuple[str, ...] = ("sphere", "cylinder")
 """Values accepted for ``[tank] shape``."""
 MIN_SAMPLES: int = 50
 """Minimum number of CSV samples (see the module docstring for why)."""
+MIN_DURATION: float = 0.1
+"""Shortest record [s] (see the module docstring for why)."""
 TIME_STEP_RTOL: float = 1e-3
 """Allowed deviation of each time step from the median step, relative to the median step."""
 

@@ -18,6 +18,7 @@ from analogs import (
 )
 from analogs.component import Rig
 from analogs.errors import InputError
+from analogs.tank.prediction import MAX_MODES
 
 from .case import Case
 
@@ -99,14 +100,31 @@ def rig_values(case: Case) -> dict[str, float]:
     return out
 
 
+def _tokens_text(spinning: bool) -> str:
+    rotor = "; `rotor` or `rN` (rotor, spinning rig)" if spinning else ""
+    return (f"valid tokens: `fixed`; `p1` to `p{MAX_MODES}` (pendulum of slosh mode N, the "
+            "modes the tank prediction gives), optionally with modifiers `:nospring`, "
+            f"`:quadratic`, `:diaphragm`{rotor}; e.g. `fixed,p1,p2:quadratic`")
+
+
+def _number_of(name: str, letter: str) -> int | None:
+    """N of ``pN``/``rN`` written without leading zeros, else None."""
+    digits = name[1:]
+    if name[:1] != letter or not digits.isascii() or not digits.isdigit():
+        return None
+    return int(digits) if digits == str(int(digits)) else None
+
+
 def model_from_spec(spec: str, case: Case) -> Model:
     """Build a model from a comma-separated specification such as ``"fixed,p1,p2"``.
 
-    Tokens: ``fixed`` (FixedMass); ``pN`` (Pendulum with HingeSpring and HingeDamper;
+    Tokens: ``fixed`` (FixedMass); ``pN`` with N from 1 to ``MAX_MODES`` (6: the modes the
+    tank prediction gives initial values for) (Pendulum with HingeSpring and HingeDamper;
     on the spinning rig a SphericalPendulum), optionally with modifiers after colons:
     ``pN:nospring`` (no hinge spring), ``pN:quadratic`` (adds a QuadraticDamper),
     ``pN:diaphragm`` (adds a DiaphragmSpring); spinning rig only: ``rotor`` or ``rN``
     (a Rotor about the tangential tank axis :data:`ROTOR_AXIS`, coupled by a viscous damper).
+    Errors name the option (``--model``) and list the valid tokens.
 
     Examples
     --------
@@ -118,25 +136,31 @@ def model_from_spec(spec: str, case: Case) -> Model:
     tokens = [tok.strip() for tok in spec.replace("+", ",").split(",") if tok.strip()]
     if not tokens:
         problems.append("empty model specification")
+    names = [tok.split(":")[0] for tok in tokens]
+    for name in sorted({n for n in names if names.count(n) > 1}):
+        problems.append(f"`{name}` is given {names.count(name)} times; give each component once")
     for tok in tokens:
         name, *mods = tok.split(":")
         unknown = [m for m in mods if m not in _MODIFIERS]
         if unknown:
-            problems.append(f"{tok!r}: unknown modifier {', '.join(map(repr, unknown))}; known: "
+            problems.append(f"`{tok}`: unknown modifier {', '.join(map(repr, unknown))}; known: "
                             + ", ".join(f"{k} ({v})" for k, v in _MODIFIERS.items()))
             continue
+        pendulum, rotor = _number_of(name, "p"), _number_of(name, "r")
         if name == "fixed":
             if mods:
-                problems.append(f"{tok!r}: `fixed` takes no modifiers")
+                problems.append(f"`{tok}`: `fixed` takes no modifiers")
             model = model + FixedMass("fixed")
-        elif name == "rotor" or (name.startswith("r") and name[1:].isdigit()):
+        elif name == "rotor" or rotor is not None:
             if not spinning:
-                problems.append(f"{tok!r}: a rotor needs a rig that rotates (`rig = \"spinning\"`)")
+                problems.append(f"`{tok}`: a rotor needs a rig that rotates (`rig = \"spinning\"`)")
             elif mods:
-                problems.append(f"{tok!r}: a rotor takes no modifiers")
+                problems.append(f"`{tok}`: a rotor takes no modifiers")
+            elif rotor == 0:
+                problems.append(f"`{tok}`: rotors are numbered from r1")
             else:
                 model = model + Rotor(name, axis=ROTOR_AXIS)
-        elif name.startswith("p") and name[1:].isdigit():
+        elif pendulum is not None and 1 <= pendulum <= MAX_MODES:
             pend = SphericalPendulum(name) if spinning else Pendulum(name)
             model = model + pend + HingeDamper(name)
             if "nospring" not in mods:
@@ -145,9 +169,12 @@ def model_from_spec(spec: str, case: Case) -> Model:
                 model = model + QuadraticDamper(name)
             if "diaphragm" in mods:
                 model = model + DiaphragmSpring(name)
+        elif pendulum is not None:
+            problems.append(f"`{tok}`: pendulums are numbered by slosh mode, from p1 to "
+                            f"p{MAX_MODES}")
         else:
-            problems.append(f"{tok!r}: unknown component; expected `fixed`, `pN` (p1, p2, ...)"
-                            + (" or `rotor`/`rN`" if spinning else ""))
+            problems.append(f"`{tok}`: unknown component")
     if problems:
-        raise InputError(f"--model {spec!r}: " + "; ".join(problems))
+        raise InputError(f"--model {spec!r}: " + "; ".join(problems) + "; "
+                         + _tokens_text(spinning))
     return model.validate()

@@ -3,6 +3,7 @@
 from __future__ import annotations
 
 import os
+import stat
 import tomllib
 from collections.abc import Mapping
 from pathlib import Path
@@ -11,7 +12,24 @@ from ._csv import read_csv
 from ._toml import Checker, read_tables, test_kind
 from .case import Case, CaseError
 
-__all__ = ["load_case"]
+__all__ = ["MAX_CASE_FILE_BYTES", "load_case"]
+
+#: Largest case file read [bytes]: a case file holds a few short tables, the samples are
+#: in its CSV.
+MAX_CASE_FILE_BYTES = 2**20
+
+
+def _not_a_file(path: Path) -> str | None:
+    """What ``path`` is when it exists and is not a regular file ("a folder", ...)."""
+    try:
+        mode = path.stat().st_mode
+    except FileNotFoundError:
+        return None
+    except (OSError, ValueError) as exc:  # ValueError: a NUL character in the path
+        return f"a path that cannot be read ({getattr(exc, 'strerror', None) or exc})"
+    if stat.S_ISREG(mode):
+        return None
+    return "a folder" if stat.S_ISDIR(mode) else "a special file (not a regular file)"
 
 
 def load_case(path: str | os.PathLike[str]) -> Case:
@@ -43,6 +61,14 @@ def load_case(path: str | os.PathLike[str]) -> Case:
     toml_path = Path(path)
     fname = toml_path.name
     try:
+        kind = _not_a_file(toml_path)
+        if kind:
+            raise CaseError([f"{fname}: expected a TOML case file at `{toml_path}`, found {kind}"])
+        size = toml_path.stat().st_size
+        if size > MAX_CASE_FILE_BYTES:
+            raise CaseError([f"{fname}: {size} bytes; a case file holds a few short tables "
+                             f"(at most {MAX_CASE_FILE_BYTES} bytes) and names its CSV in "
+                             "[test] data"])
         raw = toml_path.read_bytes()
     except FileNotFoundError:
         raise CaseError([f"{fname}: case file not found (expected a TOML file at "
@@ -50,7 +76,7 @@ def load_case(path: str | os.PathLike[str]) -> Case:
     except OSError as exc:
         raise CaseError([f"{fname}: cannot read the case file ({exc.strerror or exc})"]) from None
     try:
-        doc = tomllib.loads(raw.decode("utf-8"))
+        doc = tomllib.loads(raw.decode("utf-8-sig"))  # a byte order mark is accepted
     except UnicodeDecodeError as exc:
         raise CaseError([f"{fname}: expected a UTF-8 TOML file, found undecodable bytes "
                          f"({exc})"]) from None
@@ -70,7 +96,11 @@ def load_case(path: str | os.PathLike[str]) -> Case:
         data_path = Path(data_name)
         if not data_path.is_absolute():
             data_path = toml_path.parent / data_path
-        if not data_path.is_file():
+        kind = _not_a_file(data_path)
+        if kind:
+            problems.append(f"{fname}: [test] data: expected a CSV file at `{data_path}`, "
+                            f"found {kind}")
+        elif not data_path.is_file():
             problems.append(f"{fname}: [test] data: data file not found (expected a CSV file "
                             f"at `{data_path}`)")
         else:

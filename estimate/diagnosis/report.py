@@ -3,16 +3,20 @@ a test engineer can read in a minute."""
 
 from __future__ import annotations
 
-import json
 from pathlib import Path
 
 import numpy as np
 
 from ..data.signals import welch_spectrum
 from ..fitting.result import FitResult
+from ..outputs import json_text
 from .outcome import Diagnosis
 
-__all__ = ["write_report", "summary"]
+__all__ = ["REPORT_FILES", "write_report", "summary"]
+
+#: The files :func:`write_report` writes into its folder.
+REPORT_FILES = ("summary.md", "diagnosis.json", "fit_before_after.png", "residual_spectra.png",
+                "parameters.md")
 
 
 def _pyplot():
@@ -99,9 +103,7 @@ def write_report(d: Diagnosis, folder: str | Path, *, overwrite: bool = False) -
     """Write ``summary.md``, ``diagnosis.json``, ``fit_before_after.png``,
     ``residual_spectra.png`` and ``parameters.md`` into ``folder``."""
     folder = Path(folder)
-    names = ["summary.md", "diagnosis.json", "fit_before_after.png", "residual_spectra.png",
-             "parameters.md"]
-    existing = [n for n in names if (folder / n).exists()]
+    existing = [n for n in REPORT_FILES if (folder / n).exists()]
     if existing and not overwrite:
         raise FileExistsError(f"{folder} already holds {', '.join(existing)}; pass overwrite")
     folder.mkdir(parents=True, exist_ok=True)
@@ -130,14 +132,8 @@ def write_report(d: Diagnosis, folder: str | Path, *, overwrite: bool = False) -
     (folder / "parameters.md").write_text("\n".join(["# Baseline", ""] + _parameter_rows(d.baseline)
                                                     + ["", "# Final", ""] + _parameter_rows(d.final)) + "\n")
     (folder / "summary.md").write_text(summary(d))
-    (folder / "diagnosis.json").write_text(json.dumps(d.to_dict(), indent=2, default=_json_default))
+    (folder / "diagnosis.json").write_text(json_text(d.to_dict()))
     return folder / "summary.md"
-
-
-def _json_default(x):
-    if isinstance(x, (np.floating, np.integer)):
-        return x.item()
-    raise TypeError(type(x).__name__)
 
 
 def _drive_text(ev) -> str:

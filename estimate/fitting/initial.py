@@ -10,11 +10,16 @@ from analogs.errors import InputError
 
 from ..data.case import Case
 
-__all__ = ["predicted_values", "predicted_sources", "source_notes", "length_bounds",
-           "nominal_scale", "LENGTH_BAND"]
+__all__ = ["predicted_values", "predicted_sources", "source_notes", "prediction_conflicts",
+           "length_bounds", "nominal_scale", "LENGTH_BAND", "PREDICTION_FACTOR"]
 
 #: Pendulum lengths are kept within +/-20 % of the prediction, as the seed did.
 LENGTH_BAND = 0.20
+
+#: A ``[prediction]`` mass or length more than this factor above or below the tank's own
+#: modal prediction is reported: slosh codes and the modal analysis agree to a few per cent
+#: on clean tanks, and a diaphragm moves the first mode by tens of per cent, not 3x.
+PREDICTION_FACTOR = 3.0
 
 
 def _tank_prediction(case: Case, modes: int):
@@ -26,6 +31,30 @@ def _tank_prediction(case: Case, modes: int):
     liquid = Liquid(density=case.liquid.density, viscosity=case.liquid.kinematic_viscosity)
     return predict(tank, fill=case.tank.fill_fraction, liquid=liquid, gravity=case.rig.gravity,
                    modes=modes, diaphragm=case.tank.diaphragm)
+
+
+def prediction_conflicts(case: Case, *, factor: float = PREDICTION_FACTOR) -> list[str]:
+    """Warnings for the ``[prediction]`` values of ``case`` (pendulum mass and length, fixed
+    mass) that differ from the tank geometry's modal prediction by more than ``factor``,
+    each naming both numbers; empty without ``[prediction]``."""
+    pr = case.prediction
+    if pr is None:
+        return []
+    pred = _tank_prediction(case, 1)
+    pairs = (("pendulum_mass", pr.pendulum_mass, pred.modes[0].mass, "kg"),
+             ("pendulum_length", pr.pendulum_length, pred.modes[0].length, "m"),
+             ("fixed_mass", pr.fixed_mass, pred.fixed_mass.mass, "kg"))
+    t = case.tank
+    out = []
+    for key, given, modal, unit in pairs:
+        ratio = given / modal if modal > 0 else math.inf
+        if not 1 / factor <= ratio <= factor:
+            out.append(f"{case.path.name}: [prediction] {key} = {given:.4g} {unit} contradicts "
+                       f"the modal prediction {modal:.4g} {unit} of the tank ({t.shape}, radius "
+                       f"{t.radius:g} m, fill {t.fill_fraction:g}) by a factor {ratio:.3g} (more "
+                       f"than {factor:g}): check [tank] and [prediction]; the fit starts from "
+                       "[prediction]")
+    return out
 
 
 def predicted_values(case: Case, model: Model) -> dict[str, float]:

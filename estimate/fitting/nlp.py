@@ -23,6 +23,7 @@ import scipy.sparse as sps
 from analogs.errors import InputError
 
 from ..data.case import KNOWN_INITIAL_STATES
+from ..interrupts import surfacing
 from ._progress import Recorder, progress_printer
 from .covariance import reduced_jacobian, uncertainty
 from .problem import FitProblem
@@ -141,7 +142,8 @@ def fit(problem: FitProblem, *, transcription: Transcription = MultipleShooting(
     opts.update(dict(solver_options or {}))
     solver = ca.nlpsol("fit", "ipopt", {"x": nlp.w, "f": nlp.f, "g": nlp.g}, opts)
     lbx, ubx = nlp.bounds(est)
-    sol = solver(x0=nlp.w0, lbx=lbx, ubx=ubx, lbg=0, ubg=0)
+    with surfacing():  # an interrupt inside IPOPT is an interruption, not a non-convergence
+        sol = solver(x0=nlp.w0, lbx=lbx, ubx=ubx, lbg=0, ubg=0)
     if progress:
         print(file=sys.stderr)
     w_opt = np.asarray(sol["x"]).ravel()

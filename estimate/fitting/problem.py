@@ -15,6 +15,7 @@ from analogs.errors import InputError, UnknownNameError
 from ..data.case import Case
 from ..data.experiment import Experiment, experiment
 from ..data.models import model_for_case
+from ..data.records import refuse_repeated
 from .carriage import CarriageInput, RecordNoise, carriage_input, record_noise
 from .initial import length_bounds, nominal_scale, predicted_sources, source_notes
 
@@ -136,6 +137,7 @@ class FitProblem:
         cases = (cases,) if isinstance(cases, Case) else tuple(cases)
         if not cases:
             raise InputError("no cases to fit")
+        refuse_repeated(cases)
         if input not in INPUT_MODES:
             raise InputError(f"input must be one of {', '.join(map(repr, INPUT_MODES))}, "
                              f"got {input!r}")

@@ -11,7 +11,10 @@ from scipy import optimize, signal
 from ._common import _as_uniform, _sine_costs, _sine_design, _sine_fit
 from .spectra import dominant_frequency
 
-__all__ = ["lowpass"]
+__all__ = ["MAX_PAD_RECORDS", "lowpass"]
+
+#: Longest end padding of :func:`lowpass` and the derivative filters, in records.
+MAX_PAD_RECORDS = 2
 
 
 def _end_model(t_win: NDArray[np.float64], x_win: NDArray[np.float64], t_new: NDArray[np.float64],
@@ -21,6 +24,8 @@ def _end_model(t_win: NDArray[np.float64], x_win: NDArray[np.float64], t_new: ND
     tw, tn = t_win - t0, t_new - t0
     span = float(t_win[-1] - t_win[0])
     f_lo, f_hi = 1.0 / span, min(0.2 * fs, 25.0)
+    if not f_lo < f_hi:  # a window shorter than a period of any drive: a line it is
+        return np.polyval(np.polyfit(tw, x_win, 1), tn)
     grid = np.geomspace(f_lo, f_hi, 160)
 
     def harmonics(f: float) -> int:
@@ -41,10 +46,16 @@ def _end_model(t_win: NDArray[np.float64], x_win: NDArray[np.float64], t_new: ND
 
 def _extend(t: NDArray[np.float64], x: NDArray[np.float64], step: float, pad_seconds: float
             ) -> tuple[NDArray[np.float64], int]:
-    """Extend both ends by a fitted model (see the module docstring); return (x_ext, n_pad)."""
+    """Extend both ends by a fitted model (see the module docstring); return (x_ext, n_pad).
+
+    The padding is ``pad_seconds`` but at most :data:`MAX_PAD_RECORDS` times the record, so
+    its memory is bounded in samples whatever the sampling rate (a 1e-12 s step would
+    otherwise ask for 1e12 samples per second of padding); a filter whose response outlasts
+    twice the record cannot make use of more.
+    """
     n = t.size
     fs = 1.0 / step
-    n_pad = int(np.ceil(pad_seconds * fs))
+    n_pad = min(int(np.ceil(pad_seconds * fs)), MAX_PAD_RECORDS * n)
     n_win = min(n, max(int(round(1.0 * fs)), 16))
     # two periods of the record's dominant frequency when that is longer than 1 s
     try:

@@ -7,6 +7,7 @@ import math
 import pytest
 
 from analogs.tank import Sphere, predict
+from estimate.cli import main
 from estimate.cli import tank as _cli_tank
 
 
@@ -38,11 +39,9 @@ def test_cli_volume_fill_legacy_and_plot(tmp_path):
 
 
 def test_cli_bad_input_exits_2_with_message(capsys):
-    args = parse(["tank", "--shape", "cylinder", "--radius", "0.1", "--fill", "0.5"])
-    assert args.run(args) == 2
+    assert main(["tank", "--shape", "cylinder", "--radius", "0.1", "--fill", "0.5"]) == 2
     assert "`--length` (m) is required" in capsys.readouterr().err
-    args = parse(["tank", "--radius", "-1", "--fill", "0.5"])
-    assert args.run(args) == 2
+    assert main(["tank", "--radius", "-1", "--fill", "0.5"]) == 2
     assert "`radius` must be a positive number" in capsys.readouterr().err
     with pytest.raises(SystemExit):
         parse(["tank", "--shape", "cube", "--radius", "1", "--fill", "0.5"])
