@@ -214,5 +214,9 @@ def test_a_diaphragm_model_derives_the_same_quantities_in_monte_carlo_and_the_fi
     summary = {k for k in mc.summary() if not k.startswith("peak_")}
     assert summary == set(res.derived)
     # the draws scatter around the estimate: the median frequency within 5 standard errors
+    # (the spread of the draws when the stiffness ends at its bound of 0, where the
+    # frequency has no Wald standard error)
     f, se = res.derived["p1.frequency_hz"]
-    assert abs(mc.summary()["p1.frequency_hz"]["p50"] - f) < 5 * se
+    spread = mc.summary()["p1.frequency_hz"]["std"]
+    assert spread > 0
+    assert abs(mc.summary()["p1.frequency_hz"]["p50"] - f) < 5 * (se if math.isfinite(se) else spread)
