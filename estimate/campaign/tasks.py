@@ -5,6 +5,7 @@ and does not raise for its own errors, so one bad record never stops the others.
 
 from __future__ import annotations
 
+import dataclasses
 import math
 import time
 from dataclasses import dataclass, field
@@ -59,6 +60,22 @@ def drive_amplitude(case: Case) -> float:
     if case.crank is not None:
         return float(case.crank.radius)
     return math.nan
+
+
+def _own_arrays(case: Case) -> Case:
+    """``case`` with private aligned copies of its arrays (read-only, as loaded). Dask hands
+    arrays to a worker without copying them, possibly unaligned in its message buffer, and
+    SciPy's B-spline design matrix rejects unaligned arrays."""
+    def own(a):
+        if a is None:
+            return None
+        b = np.array(a, dtype=float, order="C", copy=True)
+        b.flags.writeable = False
+        return b
+
+    return dataclasses.replace(case, time=own(case.time), displacement=own(case.displacement),
+                               force=own(case.force),
+                               columns={k: own(v) for k, v in case.columns.items()})
 
 
 def _quantities(result) -> tuple[dict[str, list], dict[str, list]]:
@@ -128,6 +145,7 @@ def run_task(task: Task, shared: Any = None) -> dict[str, Any]:
     """
     t0 = time.perf_counter()
     try:
+        task = dataclasses.replace(task, cases=tuple(_own_arrays(c) for c in task.cases))
         outcome = _fit(task) if task.kind == "fit" else _diagnosis(task)
     except InputError as err:
         outcome = {"status": "failed", "error": str(err).replace("\n", " ")}
