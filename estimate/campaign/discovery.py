@@ -84,6 +84,9 @@ class Record:
     setup : Setup or None
         The grouping keys, None when the file does not give them all (the record is then
         in no group; loading it reports what is wrong).
+    data_bytes : int
+        Size of the data file (0: not readable), the measure of a task's work for the
+        campaign's time left.
     """
 
     id: str
@@ -92,6 +95,7 @@ class Record:
     toml_sha256: str | None
     data_sha256: str | None
     setup: Setup | None
+    data_bytes: int = 0
 
 
 @dataclass(frozen=True)
@@ -180,15 +184,17 @@ def _record(path: Path, root: Path) -> Record | None:
     test = doc["test"] if doc is not None else {}
     rid = test.get("id") if isinstance(test.get("id"), str) and test.get("id") else path.stem
     data = test.get("data")
-    data_sha = None
+    data_sha, data_bytes = None, 0
     if isinstance(data, str) and data.strip():
         data_sha = _sha256(path.parent / data)
+        if data_sha is not None:
+            data_bytes = (path.parent / data).stat().st_size
     try:
         rel = path.resolve().relative_to(root).as_posix()
     except ValueError:
         rel = str(path.resolve())
     return Record(rid, path.resolve(), rel, _sha256(path), data_sha,
-                  _setup(doc) if doc is not None else None)
+                  _setup(doc) if doc is not None else None, data_bytes)
 
 
 def _group_names(keys: list[Setup]) -> list[str]:

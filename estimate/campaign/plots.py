@@ -16,8 +16,23 @@ from .table import CampaignTable, quantity_column
 __all__ = ["plot_against_amplitude", "plot_against_fill", "plotted_quantities"]
 
 #: Horizontal spread of a group's records around their fill (percent of height), so that
-#: their intervals do not hide each other; the group's own estimate sits at the fill.
+#: their intervals do not hide each other; the group's own estimate sits at the fill, where
+#: no record is drawn.
 SPREAD = 2.4
+#: Gap left free at the fill on either side, a fraction of SPREAD.
+_GAP = 0.2
+
+
+def _spread(n: int) -> list[float]:
+    """Offsets of a group's ``n`` records from their fill: half on each side (one more on
+    the left), none within ``_GAP`` of the fill, where the group's estimate is drawn."""
+    left = (n + 1) // 2
+    gap, half = _GAP * SPREAD, SPREAD / 2
+    step = (half - gap) / max(left - 1, 1)
+    return ([-(gap + step * j) for j in reversed(range(left))]
+            + [gap + step * j for j in range(n - left)])
+
+
 _LABELS = {"fixed.mass": "fixed mass", "mass": "pendulum mass", "frequency_hz": "frequency",
            "damping_ratio": "damping ratio", "length": "pendulum length"}
 
@@ -107,8 +122,7 @@ def plot_against_fill(table: CampaignTable, curves: Sequence[PredictionCurves],
     offsets: dict[str, float] = {}
     for g in {r["group"] for r in records}:
         ids = sorted(r["id"] for r in records if r["group"] == g)
-        for k, rid in enumerate(ids):
-            offsets[rid] = SPREAD * (k - (len(ids) - 1) / 2) / max(len(ids) - 1, 1)
+        offsets |= dict(zip(ids, _spread(len(ids))))
     for (ax, dev), q in zip(pairs, quantities):
         unit = table.quantities[q]
         for i, c in enumerate(curves):

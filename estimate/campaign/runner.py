@@ -77,11 +77,17 @@ class _Runner:
         self.options = {"input": campaign.input}
         self.loaded: dict[str, Case | str] = {}      # record id -> case, or why it failed
         self.outcomes: dict[str, dict[str, Any]] = {}  # key -> outcome of this run
+        self.work: dict[str, float] = {}               # key -> work, for the time left
         self.computed = self.reused = self.failed = 0
 
     def files(self, ids: Sequence[str]) -> list[tuple[str | None, str | None]]:
         return [(self.campaign.record(i).toml_sha256, self.campaign.record(i).data_sha256)
                 for i in ids]
+
+    def work_of(self, kind: str, ids: Sequence[str]) -> float:
+        """A task's work for the progress display: the bytes of data it fits."""
+        data = sum(self.campaign.record(i).data_bytes for i in ids)
+        return float(data * (_DIAGNOSIS_COST if kind == "diagnosis" else 1))
 
     def load(self, record: Record) -> Case | str:
         if record.id not in self.loaded:
@@ -96,7 +102,9 @@ class _Runner:
         """Outcomes of ``(kind, label, record ids, model)`` tasks by key: from the store,
         from a failed load, or computed now."""
         keys = [self._key(*w) for w in wanted]
-        self.progress.expect(len(set(keys) - set(self.outcomes)))
+        new = {k: w for k, w in zip(keys, wanted) if k not in self.outcomes}
+        self.work.update({k: self.work_of(w[0], w[2]) for k, w in new.items()})
+        self.progress.expect(len(new), sum(self.work[k] for k in new))
         tasks: dict[str, Task] = {}
         for key, (kind, label, ids, model) in zip(keys, wanted):
             if key in tasks or key in self.outcomes:
@@ -105,7 +113,7 @@ class _Runner:
             if stored is not None:
                 self.outcomes[key] = stored
                 self.reused += 1
-                self.progress.from_store(1)
+                self.progress.from_store(1, self.work[key])
                 continue
             cases = [self.load(self.campaign.record(i)) for i in ids]
             bad = [f"{i}: {c}" for i, c in zip(ids, cases) if isinstance(c, str)]
@@ -113,7 +121,7 @@ class _Runner:
                 self.outcomes[key] = {"status": "failed", "error": "; ".join(bad), "stage": "load"}
                 self.failed += 1
                 self.progress.submit(1)
-                self.progress.finish(False, 0.0)
+                self.progress.finish(False, 0.0, self.work[key])
                 continue
             tasks[key] = Task(kind, key, label, tuple(cases), model, self.campaign.input)
         self._execute(sorted(tasks.values(), key=self._cost))
@@ -145,7 +153,7 @@ class _Runner:
                 self.outcomes[task.key] = outcome
                 self.computed += 1
                 self.failed += outcome["status"] == "failed"
-                self.progress.finish(outcome["status"] != "failed", seconds)
+                self.progress.finish(outcome["status"] != "failed", seconds, self.work[task.key])
 
 
 def run_campaign(campaign: Campaign, out: str | Path, *, executor: Executor | None = None,
@@ -179,6 +187,9 @@ def run_campaign(campaign: Campaign, out: str | Path, *, executor: Executor | No
     runner = _Runner(campaign, Store(Path(out) / "store"), executor, bar)
     ids = [r.id for r in campaign.records]
     try:
+        # the groups' fits come once the records' are known; count them from the start
+        bar.plan(len(campaign.groups), sum(runner.work_of("fit", g.records)
+                                           for g in campaign.groups))
         stage = [("fit", f"record {i}", (i,), campaign.model_of(i)) for i in ids]
         if diagnose:
             stage += [("diagnosis", f"diagnosis {i}", (i,), None) for i in ids]
@@ -196,6 +207,7 @@ def run_campaign(campaign: Campaign, out: str | Path, *, executor: Executor | No
             members = tuple(i for i in g.records if i not in excluded[g.name])
             if members:
                 groups.append((g.name, ("fit", f"group {g.name}", members, g.model)))
+        bar.plan(0)
         fitted = runner.run([w for _, w in groups])
     finally:
         bar.close()

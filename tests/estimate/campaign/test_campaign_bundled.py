@@ -1,13 +1,15 @@
 """The bundled SYNTHETIC campaign (``examples/campaign``, 12 records made by the independent
-reference simulator; truth: the exact tank prediction per fill) run as the README runs it:
+reference simulator; truth: the exact tank prediction per fill) run with the README's command:
 each fill's group fit reproduces the generator's parameters within the fit tolerances, the
 record with the hidden second mode is the one outlier, and a 2-worker Dask cluster writes
 the same table as the local run. Slow: about a minute of fits, twice."""
 
 from __future__ import annotations
 
+import shlex
+
 import pytest
-from campaign_helpers import BUNDLED, TOLERANCES, TRUTH, read_csv
+from campaign_helpers import BUNDLED, ROOT, TOLERANCES, TRUTH, read_csv
 
 from estimate.cli import main
 
@@ -15,10 +17,20 @@ pytestmark = pytest.mark.slow
 HIDDEN = "F60_sweep_0.6mm"
 
 
+def readme_command() -> list[str]:
+    """The README's one command that runs the bundled campaign, as arguments of `slosh`."""
+    text = (ROOT / "README.md").read_text()
+    line = next(ln for ln in text.splitlines() if "slosh campaign examples/campaign" in ln)
+    return shlex.split(line.split("&& slosh ", 1)[1])
+
+
 @pytest.fixture(scope="module")
 def local(tmp_path_factory):
     out = tmp_path_factory.mktemp("bundled") / "local"
-    assert main(["campaign", str(BUNDLED), "--out", str(out)]) == 0
+    args = readme_command()
+    assert args[:2] == ["campaign", "examples/campaign"] and args[2] == "--out", args
+    args[1], args[3] = str(ROOT / args[1]), str(out)
+    assert main(args) == 0
     return out
 
 

@@ -102,6 +102,23 @@ def test_progress_shows_on_a_terminal_only():
     assert shown.getvalue().endswith(p.line())
 
 
+def test_the_time_left_weighs_tasks_by_their_work_and_counts_planned_groups():
+    p = Progress(2, enabled=False)
+    p.plan(1, 300.0)                       # one group of 300 units, fitted after the records
+    p.expect(3, 300.0)                     # three records of 100 units
+    p.submit(3)
+    p.finish(True, 5.0, 100.0)             # 0.05 s per unit
+    p.finish(False, 0.0, 100.0)            # failed to load: done, but tells no speed
+    # 100 + 300 units left at 0.05 s per unit on 2 workers
+    assert p.line() == ("campaign: 2/4 tasks done (0 from the store), 1 failed, 1 running, "
+                        "about 0:10 left")
+    p.finish(True, 5.0, 100.0)
+    p.plan(0)
+    p.expect(1, 300.0)
+    # the group alone: one worker runs it, 300 units at 0.05 s
+    assert p.line().startswith("campaign: 3/4 tasks done") and p.line().endswith("0:15 left")
+
+
 def _square(x, shared=None):
     if x == 3:
         raise ValueError("three")
