@@ -59,8 +59,9 @@ def run(args: argparse.Namespace) -> int:
     campaign = discover(args.source, model=args.model)
     CampaignTable((), (), {}).to_parquet()      # a missing pyarrow is said before any fit
     resumed = claim_folder(args.out, args.source, overwrite=args.overwrite)
-    print(f"campaign {campaign.source}: {len(campaign.records)} records in "
-          f"{len(campaign.groups)} groups" + (", resuming" if resumed else ""))
+    n, g = len(campaign.records), len(campaign.groups)
+    print(f"campaign {campaign.source}: {n} record{'s' * (n != 1)} in {g} group{'s' * (g != 1)}"
+          + (", resuming" if resumed else ""))
     try:
         with _executor(args) as executor:
             result = run_campaign(campaign, args.out, executor=executor, diagnose=args.diagnose)

@@ -2,14 +2,15 @@
 reference simulator; truth: the exact tank prediction per fill) run with the README's command:
 each fill's group fit reproduces the generator's parameters within the fit tolerances, the
 record with the hidden second mode is the one outlier, and a 2-worker Dask cluster writes
-the same table as the local run. Slow: about a minute of fits, twice."""
+the same table as the local run; `--diagnose` names the hidden mode. Slow: about a minute
+of fits, twice, and two diagnoses."""
 
 from __future__ import annotations
 
 import shlex
 
 import pytest
-from campaign_helpers import BUNDLED, ROOT, TOLERANCES, TRUTH, read_csv
+from campaign_helpers import BUNDLED, MODEL, ROOT, TOLERANCES, TRUTH, copy_records, read_csv
 
 from estimate.cli import main
 
@@ -62,3 +63,18 @@ def test_a_two_worker_dask_cluster_writes_the_same_table(local, tmp_path):
     assert main(["campaign", str(BUNDLED), "--out", str(out), "--cluster", "2"]) == 0
     for name in ("campaign.csv", "campaign.parquet"):
         assert (out / name).read_bytes() == (local / name).read_bytes()
+
+
+def test_diagnose_names_the_hidden_mode_in_the_verdict_column(tmp_path):
+    """`--diagnose` on the hidden-mode record and a clean one of the same fill (slow: two
+    diagnoses, about 100 s on 2 busy cores)."""
+    folder = copy_records(tmp_path / "cases", [HIDDEN, "F60_sweep_0.3mm"],
+                          campaign_toml=f'[campaign]\nmodel = "{MODEL}"\n')
+    out = tmp_path / "out"
+    assert main(["campaign", str(folder), "--out", str(out), "--diagnose"]) == 0
+    verdicts = {r["id"]: r["verdict"] for r in read_csv(out / "campaign.csv")
+                if r["kind"] == "record"}
+    assert verdicts["F60_sweep_0.3mm"] == "no finding"
+    assert "(+p2" in verdicts[HIDDEN], verdicts       # a second pendulum is what it lacks
+    report = (out / "report" / "report.md").read_text()
+    assert f"**{HIDDEN}**" in report and f"diagnosis: {verdicts[HIDDEN]}" in report
