@@ -99,7 +99,15 @@ def test_an_interrupted_run_resumes_to_the_same_table(campaign, tmp_path, capsys
     folder, reference, _ = campaign
     out = tmp_path / "out"
     env = {**os.environ, "OMP_NUM_THREADS": "1", "OPENBLAS_NUM_THREADS": "1"}
-    cli = "import sys; from estimate.cli import main; sys.exit(main(sys.argv[1:]))"
+    # Ctrl-C as on a terminal: a process started with SIGINT ignored (as a test runner's
+    # worker may start its children) keeps ignoring it, so the child installs Python's own
+    # handler and says when it had to
+    cli = ("import signal, sys\n"
+           "if signal.getsignal(signal.SIGINT) is not signal.default_int_handler:\n"
+           "    print('SIGINT was', signal.getsignal(signal.SIGINT), file=sys.stderr)\n"
+           "    signal.signal(signal.SIGINT, signal.default_int_handler)\n"
+           "from estimate.cli import main\n"
+           "sys.exit(main(sys.argv[1:]))")
     proc = subprocess.Popen([sys.executable, "-c", cli, "campaign", str(folder),
                              "--out", str(out), "--threads", "1"], cwd=ROOT, env=env,
                             stdout=subprocess.PIPE, stderr=subprocess.PIPE, text=True)
@@ -109,8 +117,8 @@ def test_an_interrupted_run_resumes_to_the_same_table(campaign, tmp_path, capsys
         assert proc.poll() is None and time.monotonic() < deadline, proc.communicate()
         time.sleep(0.05)
     proc.send_signal(signal.SIGINT)
-    _, err = proc.communicate(timeout=120)
-    assert proc.returncode == 130, err
+    stdout, err = proc.communicate(timeout=120)
+    assert proc.returncode == 130, (stdout, err)
     assert "run the same command again to resume" in err
     kept = [p.name for p in store.iterdir()]
     assert 1 <= len(kept) < TASKS and all(n.endswith(".json") and not n.startswith(".")
