@@ -99,13 +99,15 @@ def test_an_interrupted_run_resumes_to_the_same_table(campaign, tmp_path, capsys
     folder, reference, _ = campaign
     out = tmp_path / "out"
     env = {**os.environ, "OMP_NUM_THREADS": "1", "OPENBLAS_NUM_THREADS": "1"}
-    # Ctrl-C as on a terminal: a process started with SIGINT ignored (as a test runner's
-    # worker may start its children) keeps ignoring it, so the child installs Python's own
-    # handler and says when it had to
+    # Ctrl-C as on a terminal: a child inherits an ignored SIGINT or a mask that blocks it
+    # from the thread that starts it (a test runner's worker may have either), so the child
+    # restores Python's handler and unblocks the signal, and says when it had to
     cli = ("import signal, sys\n"
            "if signal.getsignal(signal.SIGINT) is not signal.default_int_handler:\n"
            "    print('SIGINT was', signal.getsignal(signal.SIGINT), file=sys.stderr)\n"
            "    signal.signal(signal.SIGINT, signal.default_int_handler)\n"
+           "if signal.SIGINT in signal.pthread_sigmask(signal.SIG_UNBLOCK, {signal.SIGINT}):\n"
+           "    print('SIGINT was blocked', file=sys.stderr)\n"
            "from estimate.cli import main\n"
            "sys.exit(main(sys.argv[1:]))")
     proc = subprocess.Popen([sys.executable, "-c", cli, "campaign", str(folder),
