@@ -8,7 +8,7 @@ are deterministic gives identical results everywhere.
 from __future__ import annotations
 
 import os
-from collections.abc import Callable, Iterable, Sequence
+from collections.abc import Callable, Iterable, Iterator, Sequence
 from typing import Any
 
 from analogs.errors import InputError, MissingDependency
@@ -23,6 +23,22 @@ class Executor:
     def map(self, fn: Callable[[Any, Any], Any], items: Sequence[Any], shared: Any = None
             ) -> list[Any]:
         raise NotImplementedError
+
+    def as_completed(self, fn: Callable[[Any, Any], Any], items: Sequence[Any],
+                     shared: Any = None) -> Iterator[tuple[int, Any]]:
+        """Run ``fn(item, shared=shared)`` for each of ``items``; yield ``(index, future)`` as
+        each task ends, in the order they end. ``future.result()`` returns the task's value
+        or raises its exception. Closing the iterator early (``break``, an interrupt)
+        cancels the tasks that have not started."""
+        from concurrent.futures import Future
+
+        for i, item in enumerate(items):
+            future: Future = Future()
+            try:
+                future.set_result(fn(item, shared=shared))
+            except Exception as err:
+                future.set_exception(err)
+            yield i, future
 
     def close(self) -> None:
         """Release workers the executor started (nothing for the local executor)."""
@@ -57,6 +73,21 @@ class LocalExecutor(Executor):
 
         with ThreadPoolExecutor(self.threads) as pool:
             return list(pool.map(lambda item: fn(item, shared=shared), items))
+
+    def as_completed(self, fn: Callable[[Any, Any], Any], items: Sequence[Any],
+                     shared: Any = None) -> Iterator[tuple[int, Any]]:
+        # always on worker threads, even one: the calling thread only waits, so an
+        # interrupt reaches it there and never lands inside a task
+        from concurrent.futures import ThreadPoolExecutor
+        from concurrent.futures import as_completed as completed
+
+        pool = ThreadPoolExecutor(self.threads)
+        try:
+            futures = {pool.submit(fn, item, shared=shared): i for i, item in enumerate(items)}
+            for future in completed(futures):
+                yield futures[future], future
+        finally:
+            pool.shutdown(wait=False, cancel_futures=True)
 
     @property
     def workers(self) -> int:
@@ -119,6 +150,18 @@ class DaskExecutor(Executor):
         data = self.client.scatter(shared, broadcast=True) if shared is not None else None
         futures = self.client.map(fn, list(items), shared=data, pure=False)
         return self.client.gather(futures)
+
+    def as_completed(self, fn: Callable[[Any, Any], Any], items: Sequence[Any],
+                     shared: Any = None) -> Iterator[tuple[int, Any]]:
+        distributed = _import_distributed()
+        data = self.client.scatter(shared, broadcast=True) if shared is not None else None
+        futures = self.client.map(fn, list(items), shared=data, pure=False)
+        index = {f.key: i for i, f in enumerate(futures)}
+        try:
+            for future in distributed.as_completed(futures):
+                yield index[future.key], future
+        finally:
+            self.client.cancel([f for f in futures if not f.done()])
 
     def close(self) -> None:
         if self._own:

@@ -9,7 +9,7 @@ import sys
 
 __all__ = ["main"]
 
-_COMMANDS = ("fit", "simulate", "diagnose", "tank", "export", "montecarlo", "ntc")
+_COMMANDS = ("fit", "simulate", "diagnose", "tank", "export", "montecarlo", "ntc", "campaign")
 
 
 def _parser() -> argparse.ArgumentParser:

@@ -11,7 +11,8 @@ from analogs.errors import InputError
 from ..data.case import Case
 
 __all__ = ["predicted_values", "predicted_sources", "source_notes", "prediction_conflicts",
-           "length_bounds", "nominal_scale", "LENGTH_BAND", "PREDICTION_FACTOR"]
+           "length_bounds", "nominal_scale", "tank_prediction", "LENGTH_BAND",
+           "PREDICTION_FACTOR"]
 
 #: Pendulum lengths are kept within +/-20 % of the prediction, as the seed did.
 LENGTH_BAND = 0.20
@@ -22,15 +23,24 @@ LENGTH_BAND = 0.20
 PREDICTION_FACTOR = 3.0
 
 
-def _tank_prediction(case: Case, modes: int):
+def tank_prediction(shape: str, radius: float, fill: float, *, density: float,
+                    viscosity: float, gravity: float, modes: int = 1, method: str = "exact",
+                    diaphragm: bool = False):
+    """The tank modal analysis (:func:`analogs.tank.predict`) of a case file's tank: a
+    sphere, or a cylinder as tall as its diameter; radius in m, fill as liquid depth / tank
+    height, density in kg/m^3, kinematic viscosity in m^2/s, gravity in m/s^2."""
     from analogs.tank import Cylinder, Liquid, Sphere, predict
 
-    shape = case.tank.shape
-    R = case.tank.radius
-    tank = Sphere(R) if shape == "sphere" else Cylinder(R, 2 * R)
-    liquid = Liquid(density=case.liquid.density, viscosity=case.liquid.kinematic_viscosity)
-    return predict(tank, fill=case.tank.fill_fraction, liquid=liquid, gravity=case.rig.gravity,
-                   modes=modes, diaphragm=case.tank.diaphragm)
+    tank = Sphere(radius) if shape == "sphere" else Cylinder(radius, 2 * radius)
+    return predict(tank, fill=fill, liquid=Liquid(density=density, viscosity=viscosity),
+                   gravity=gravity, modes=modes, method=method, diaphragm=diaphragm)
+
+
+def _tank_prediction(case: Case, modes: int):
+    return tank_prediction(case.tank.shape, case.tank.radius, case.tank.fill_fraction,
+                           density=case.liquid.density,
+                           viscosity=case.liquid.kinematic_viscosity, gravity=case.rig.gravity,
+                           modes=modes, diaphragm=case.tank.diaphragm)
 
 
 def prediction_conflicts(case: Case, *, factor: float = PREDICTION_FACTOR) -> list[str]:

@@ -1,0 +1,351 @@
+"""A campaign's records and groups: the case files of a folder or glob, the optional
+``campaign.toml``, and the groups whose records share their physical parameters in one
+multi-case fit.
+
+Without groups in ``campaign.toml``, records are grouped by their ``[tank]`` and
+``[liquid]`` tables and rig: the same tank at the same fill with the same liquid on the same
+rig, across drives and amplitudes, is one group. ``campaign.toml`` (in the folder, or in the
+top folder of a glob pattern) may give a title, a note, the model and explicit groups::
+
+    [campaign]
+    title = "8-inch sphere, water"
+    note = "SYNTHETIC data"
+    model = "fixed,p1:nospring"     # default: the model of `slosh fit`
+    input = "estimated"             # or "filtered" (see `slosh fit --input`)
+
+    [groups.low]                    # optional; then only these groups
+    records = ["F40_*"]             # record ids or case files (globs, relative to this file)
+    model = "fixed,p1"              # optional, this group's model
+
+Only the file's bytes are read here (parsed as TOML for ids and grouping keys); the cases are
+validated when they are loaded for fitting, and a record that fails then fails alone.
+"""
+
+from __future__ import annotations
+
+import fnmatch
+import glob
+import hashlib
+import tomllib
+from collections.abc import Mapping
+from dataclasses import dataclass
+from pathlib import Path
+from typing import Any
+
+from analogs.errors import InputError
+
+from ..data.models import BASELINE
+from ..fitting.problem import INPUT_MODES
+
+__all__ = ["CAMPAIGN_FILE", "Campaign", "Group", "Record", "Setup", "discover"]
+
+#: The campaign description file looked for in the campaign folder.
+CAMPAIGN_FILE = "campaign.toml"
+_CAMPAIGN_KEYS = {"title", "note", "model", "input"}
+_GROUP_KEYS = {"records", "model"}
+
+
+@dataclass(frozen=True)
+class Setup:
+    """What makes records one group: rig kind, ``[tank]`` (shape, radius in m, fill
+    fraction, diaphragm) and ``[liquid]`` (density in kg/m^3, kinematic viscosity in
+    m^2/s), and ``[rig] gravity`` (m/s^2) for the tank prediction."""
+
+    rig: str
+    shape: str
+    radius: float
+    fill_fraction: float
+    diaphragm: bool
+    density: float
+    viscosity: float
+    gravity: float
+
+    @property
+    def series(self) -> tuple:
+        """The setup without the fill: records of one series lie on one prediction curve."""
+        return (self.rig, self.shape, self.radius, self.diaphragm, self.density,
+                self.viscosity, self.gravity)
+
+
+@dataclass(frozen=True)
+class Record:
+    """One case file of the campaign.
+
+    Attributes
+    ----------
+    id : str
+        ``[test] id`` (the file name without ``.toml`` when the file cannot be read).
+    path : pathlib.Path
+        The case file, resolved.
+    relpath : str
+        The case file relative to the campaign folder (POSIX separators).
+    toml_sha256, data_sha256 : str or None
+        SHA-256 of the case file's and of its data file's bytes (None: not readable).
+    setup : Setup or None
+        The grouping keys, None when the file does not give them all (the record is then
+        in no group; loading it reports what is wrong).
+    data_bytes : int
+        Size of the data file (0: not readable), the measure of a task's work for the
+        campaign's time left.
+    """
+
+    id: str
+    path: Path
+    relpath: str
+    toml_sha256: str | None
+    data_sha256: str | None
+    setup: Setup | None
+    data_bytes: int = 0
+
+
+@dataclass(frozen=True)
+class Group:
+    """Records fitted together (shared physical parameters) with ``model``."""
+
+    name: str
+    records: tuple[str, ...]
+    model: str
+
+
+@dataclass(frozen=True)
+class Campaign:
+    """A discovered campaign (see :func:`discover`)."""
+
+    source: str
+    root: Path
+    title: str
+    note: str
+    model: str
+    input: str
+    records: tuple[Record, ...]
+    groups: tuple[Group, ...]
+    #: TOML files that are not case files (no ``[test]`` table).
+    skipped: tuple[str, ...] = ()
+
+    def record(self, record_id: str) -> Record:
+        return next(r for r in self.records if r.id == record_id)
+
+    def group_of(self, record_id: str) -> Group | None:
+        return next((g for g in self.groups if record_id in g.records), None)
+
+    def model_of(self, record_id: str) -> str:
+        """The model of a record: its group's."""
+        group = self.group_of(record_id)
+        return group.model if group is not None else self.model
+
+
+def _sha256(path: Path) -> str | None:
+    try:
+        with path.open("rb") as fh:
+            return hashlib.file_digest(fh, "sha256").hexdigest()
+    except OSError:
+        return None
+
+
+def _read_toml(path: Path) -> dict[str, Any] | None:
+    try:
+        return tomllib.loads(path.read_bytes().decode("utf-8"))
+    except (OSError, UnicodeDecodeError, tomllib.TOMLDecodeError):
+        return None
+
+
+def _setup(doc: Mapping[str, Any]) -> Setup | None:
+    try:
+        test, tank, liquid, rig = (doc[k] for k in ("test", "tank", "liquid", "rig"))
+        return Setup(rig=str(test.get("rig", "lateral")), shape=str(tank["shape"]),
+                     radius=float(tank["radius"]), fill_fraction=float(tank["fill_fraction"]),
+                     diaphragm=bool(tank.get("diaphragm", False)),
+                     density=float(liquid["density"]),
+                     viscosity=float(liquid["kinematic_viscosity"]),
+                     gravity=float(rig.get("gravity", 9.80665)))
+    except (KeyError, TypeError, ValueError, AttributeError):
+        return None
+
+
+def _case_files(source: str) -> tuple[Path, list[Path]]:
+    """The campaign folder and the TOML files of ``source`` (a folder or a glob)."""
+    src = Path(source)
+    if src.is_dir():
+        return src.resolve(), sorted(p for p in src.rglob("*.toml") if p.is_file())
+    if not glob.has_magic(source):
+        raise InputError(f"{source}: no such folder (expected a folder of case files or a glob "
+                         "such as `tests/*.toml`)")
+    parts = Path(source).parts
+    top = Path(*[p for p in parts[:next(i for i, p in enumerate(parts) if glob.has_magic(p))]]
+               or ["."])
+    return top.resolve(), sorted(Path(p) for p in glob.glob(source, recursive=True)
+                                 if p.endswith(".toml") and Path(p).is_file())
+
+
+def _record(path: Path, root: Path) -> Record | None:
+    doc = _read_toml(path)
+    if doc is not None and not isinstance(doc.get("test"), Mapping):
+        return None                                  # a TOML file, not a case file
+    test = doc["test"] if doc is not None else {}
+    rid = test.get("id") if isinstance(test.get("id"), str) and test.get("id") else path.stem
+    data = test.get("data")
+    data_sha, data_bytes = None, 0
+    if isinstance(data, str) and data.strip():
+        data_sha = _sha256(path.parent / data)
+        if data_sha is not None:
+            data_bytes = (path.parent / data).stat().st_size
+    try:
+        rel = path.resolve().relative_to(root).as_posix()
+    except ValueError:
+        rel = str(path.resolve())
+    return Record(rid, path.resolve(), rel, _sha256(path), data_sha,
+                  _setup(doc) if doc is not None else None, data_bytes)
+
+
+def _group_names(keys: list[Setup]) -> list[str]:
+    """Readable unique names: shape, radius and fill, plus what else varies."""
+    varying = [f for f in ("rig", "diaphragm", "density", "viscosity", "gravity")
+               if len({getattr(k, f) for k in keys}) > 1]
+    names = []
+    for k in keys:
+        name = f"{k.shape}-R{k.radius:g}-fill{k.fill_fraction:g}"
+        for f in varying:
+            v = getattr(k, f)
+            name += (f"-{v}" if f == "rig" else "-diaphragm" if f == "diaphragm" and v
+                     else "" if f == "diaphragm" else f"-{f}{v:g}")
+        names.append(name)
+    return names
+
+
+def _groups_by_keys(records: tuple[Record, ...], model: str) -> tuple[Group, ...]:
+    by_key: dict[Setup, list[str]] = {}
+    for r in records:
+        if r.setup is not None:
+            by_key.setdefault(r.setup, []).append(r.id)
+    keys = sorted(by_key, key=lambda k: (k.series, k.fill_fraction))
+    return tuple(Group(name, tuple(sorted(by_key[k])), model)
+                 for name, k in zip(_group_names(keys), keys))
+
+
+def _explicit_groups(doc: Mapping[str, Any], fname: str, records: tuple[Record, ...],
+                     model: str, problems: list[str]) -> tuple[Group, ...]:
+    groups: list[Group] = []
+    owner: dict[str, str] = {}
+    for name, table in doc.items():
+        where = f"{fname}: [groups.{name}]"
+        if not isinstance(table, Mapping):
+            problems.append(f"{where}: expected a table with `records`, found {table!r}")
+            continue
+        for key in sorted(set(table) - _GROUP_KEYS):
+            problems.append(f"{where}: unknown key `{key}` (known: records, model)")
+        pats = table.get("records")
+        if not (isinstance(pats, list) and pats and all(isinstance(p, str) for p in pats)):
+            problems.append(f"{where} records: expected a list of record ids or case-file "
+                            f"globs, found {pats!r}")
+            continue
+        gm = table.get("model", model)
+        if not isinstance(gm, str) or not gm.strip():
+            problems.append(f"{where} model: expected a model specification such as "
+                            f"\"fixed,p1\", found {gm!r}")
+        members = []
+        for pat in pats:
+            hit = [r.id for r in records
+                   if fnmatch.fnmatchcase(r.id, pat) or fnmatch.fnmatchcase(r.relpath, pat)]
+            if not hit:
+                problems.append(f"{where} records: {pat!r} matches no record")
+            members += [h for h in hit if h not in members]
+        for m in members:
+            if m in owner:
+                problems.append(f"{where}: record {m!r} is already in group {owner[m]!r}")
+            owner.setdefault(m, name)
+        groups.append(Group(name, tuple(sorted(members)), gm if isinstance(gm, str) else model))
+    return tuple(groups)
+
+
+def _settings(path: Path, records: tuple[Record, ...]) -> tuple[dict[str, Any], tuple[Group, ...]
+                                                                 | None]:
+    """``[campaign]`` settings and the explicit groups of ``campaign.toml`` (None: group by
+    keys); every problem of the file is reported at once."""
+    if not path.is_file():
+        return {}, None
+    try:
+        doc = tomllib.loads(path.read_text(encoding="utf-8"))
+    except (UnicodeDecodeError, tomllib.TOMLDecodeError) as err:
+        raise InputError(f"{path}: invalid TOML: {err}") from None
+    fname, problems = path.name, []
+    for key in sorted(set(doc) - {"campaign", "groups"}):
+        problems.append(f"{fname}: unknown table `[{key}]` (known: [campaign], [groups.NAME])")
+    settings = doc.get("campaign", {})
+    if not isinstance(settings, Mapping):
+        problems.append(f"{fname}: [campaign]: expected a table")
+        settings = {}
+    for key in sorted(set(settings) - _CAMPAIGN_KEYS):
+        problems.append(f"{fname}: [campaign]: unknown key `{key}` (known: "
+                        f"{', '.join(sorted(_CAMPAIGN_KEYS))})")
+    for key in sorted(_CAMPAIGN_KEYS & set(settings)):
+        if not isinstance(settings[key], str):
+            problems.append(f"{fname}: [campaign] {key}: expected a string, found "
+                            f"{settings[key]!r}")
+    if settings.get("input", "estimated") not in INPUT_MODES:
+        problems.append(f"{fname}: [campaign] input: expected one of "
+                        f"{', '.join(INPUT_MODES)}, found {settings['input']!r}")
+    groups = None
+    if "groups" in doc:
+        model = settings.get("model") if isinstance(settings.get("model"), str) else BASELINE
+        raw = doc["groups"] if isinstance(doc["groups"], Mapping) else {}
+        groups = _explicit_groups(raw, fname, records, model, problems)
+    if problems:
+        count = len(problems)
+        raise InputError(f"{count} problem{'s' if count > 1 else ''} in the campaign file:\n"
+                         + "\n".join(f"  - {p}" for p in problems))
+    return dict(settings), groups
+
+
+def discover(source: str, *, model: str | None = None) -> Campaign:
+    """The records and groups of a campaign.
+
+    Parameters
+    ----------
+    source : str
+        A folder (its ``*.toml`` case files, searched recursively, and its
+        ``campaign.toml``) or a glob pattern of case files (``"tests/**/*.toml"``; a
+        ``campaign.toml`` in the pattern's top folder is used).
+    model : str, optional
+        Model specification for every record and group, over those of ``campaign.toml``.
+
+    Returns
+    -------
+    Campaign
+
+    Raises
+    ------
+    InputError
+        No case file found, two case files with the same ``[test] id``, or problems in
+        ``campaign.toml`` (all listed at once).
+
+    Examples
+    --------
+    >>> campaign = discover("examples/campaign")          # doctest: +SKIP
+    >>> [g.name for g in campaign.groups]                 # doctest: +SKIP
+    ['sphere-R0.1016-fill0.4', 'sphere-R0.1016-fill0.6', 'sphere-R0.1016-fill0.8']
+    """
+    root, files = _case_files(source)
+    settings_file = root / CAMPAIGN_FILE
+    files = [f for f in files if f.resolve() != settings_file]
+    found = [(f, _record(f, root)) for f in files]
+    records = tuple(sorted((r for _, r in found if r is not None), key=lambda r: r.id))
+    skipped = tuple(str(f) for f, r in found if r is None)
+    if not records:
+        raise InputError(f"{source}: no case files (TOML files with a [test] table) found")
+    seen: dict[str, list[str]] = {}
+    for r in records:
+        seen.setdefault(r.id, []).append(r.relpath)
+    dupes = {k: v for k, v in seen.items() if len(v) > 1}
+    if dupes:
+        raise InputError("record ids must be unique in a campaign; "
+                         + "; ".join(f"[test] id {k!r} in {', '.join(v)}" for k, v in dupes.items()))
+    settings, groups = _settings(settings_file, records)
+    spec = model or settings.get("model") or BASELINE
+    if groups is None:
+        groups = _groups_by_keys(records, spec)
+    elif model is not None:
+        groups = tuple(Group(g.name, g.records, model) for g in groups)
+    return Campaign(source=str(source), root=root, title=settings.get("title", ""),
+                    note=settings.get("note", ""), model=spec,
+                    input=settings.get("input", "estimated"), records=records, groups=groups,
+                    skipped=skipped)

@@ -1,0 +1,157 @@
+"""The work of a campaign, one task at a time, on whichever worker runs it: a fit of one
+record or of a group, or the diagnosis of one record. A task returns a JSON-ready outcome
+and does not raise for its own errors, so one bad record never stops the others.
+"""
+
+from __future__ import annotations
+
+import dataclasses
+import math
+import time
+from dataclasses import dataclass, field
+from typing import Any
+
+import numpy as np
+
+from analogs.errors import InputError
+
+from ..data.case import Case
+
+__all__ = ["Task", "drive_amplitude", "run_task"]
+
+#: Level of the intervals in the campaign table (the fit report's 95 %).
+LEVEL = 0.95
+
+
+@dataclass(frozen=True)
+class Task:
+    """A unit of campaign work.
+
+    Attributes
+    ----------
+    kind : {"fit", "diagnosis"}
+    key : str
+        Store key of its inputs (:func:`estimate.campaign.store.task_key`).
+    label : str
+        What it is, for messages: ``"record F40_sine_1.5mm"``, ``"group fill40"``.
+    cases : tuple of Case
+        The loaded cases, in fitting order.
+    model : str or None
+        Model specification (``None`` for a diagnosis: it starts from its baseline).
+    input : str
+        How a measured carriage displacement enters the fit (``FitProblem.build(input=)``).
+    """
+
+    kind: str
+    key: str
+    label: str
+    cases: tuple[Case, ...] = field(repr=False)
+    model: str | None
+    input: str = "estimated"
+
+
+def drive_amplitude(case: Case) -> float:
+    """Amplitude of the carriage motion (m): half the spread between the 0.5 and 99.5
+    percentiles of the measured displacement (robust to noise spikes), or the crank radius
+    of a crank-driven case; NaN for a spinning-rig case."""
+    if case.displacement is not None:
+        lo, hi = np.percentile(case.displacement, [0.5, 99.5])
+        return float(hi - lo) / 2
+    if case.crank is not None:
+        return float(case.crank.radius)
+    return math.nan
+
+
+def _own_arrays(case: Case) -> Case:
+    """``case`` with private aligned copies of its arrays (read-only, as loaded). Dask hands
+    arrays to a worker without copying them, possibly unaligned in its message buffer, and
+    SciPy's B-spline design matrix rejects unaligned arrays."""
+    def own(a):
+        if a is None:
+            return None
+        b = np.array(a, dtype=float, order="C", copy=True)
+        b.flags.writeable = False
+        return b
+
+    return dataclasses.replace(case, time=own(case.time), displacement=own(case.displacement),
+                               force=own(case.force),
+                               columns={k: own(v) for k, v in case.columns.items()})
+
+
+def _quantities(result) -> tuple[dict[str, list], dict[str, list]]:
+    """Shared estimates and derived quantities as ``[value, stderr, lo, hi, unit]``."""
+    from scipy.stats import t as student
+
+    q = float(student.ppf(0.5 + LEVEL / 2, result.dof))
+    params = {}
+    for e, v, se in zip(result.problem.estimated, result.values, result.stderr):
+        if e.case is None:          # per-case crank corrections stay out of the table
+            lo, hi = result.interval(e.name, LEVEL)
+            params[e.name] = [float(v), float(se), lo, hi, e.unit]
+    derived = {k: [v, se, v - q * se, v + q * se, result.derived_units.get(k, "")]
+               for k, (v, se) in result.derived.items()}
+    return params, derived
+
+
+def _fit(task: Task) -> dict[str, Any]:
+    from ..data.models import model_from_spec
+    from ..fitting.nlp import fit
+    from ..fitting.problem import FitProblem
+
+    cases = task.cases
+    model = model_from_spec(task.model, cases[0])
+    result = fit(FitProblem.build(cases, model, input=task.input), progress=False)
+    params, derived = _quantities(result)
+    noise = [n.force_noise if n is not None else math.nan
+             for n in (result.problem.noise or [None] * len(cases))]
+    n = [int(c.n_samples) for c in cases]
+    pooled = math.sqrt(sum(k * s**2 for k, s in zip(n, noise)) / sum(n))
+    return {
+        "status": "ok" if result.converged else "not_converged",
+        "error": None if result.converged else f"IPOPT: {result.status}",
+        "cases": [c.test.id for c in cases], "model": task.model,
+        "solver_status": result.status, "iterations": int(result.iterations),
+        "samples": sum(n), "rms_residual": float(result.rms_residual), "noise": pooled,
+        "parameters": params, "derived": derived,
+        "records": {c.test.id: {"amplitude_m": drive_amplitude(c), "samples": k,
+                                "force_noise": s} for c, k, s in zip(cases, n, noise)},
+        "warnings": list(result.warnings),
+    }
+
+
+def _diagnosis(task: Task) -> dict[str, Any]:
+    from ..diagnosis.search import diagnose
+
+    d = diagnose(list(task.cases))
+    findings = [{"cause": f.cause, "added": list(f.added), "gain": f.gain,
+                 "bic_change": f.bic_change} for f in d.findings]
+    verdict = ("; ".join(f"{f['cause']} (+{', '.join(f['added'])})" for f in findings)
+               or "no finding")
+    return {"status": "ok", "error": None, "cases": [c.test.id for c in task.cases],
+            "verdict": verdict, "findings": findings,
+            "final_model": list(d.final.problem.model.names),
+            "rms_baseline": float(d.baseline.rms_residual),
+            "rms_final": float(d.final.rms_residual), "notes": list(d.notes)}
+
+
+def run_task(task: Task, shared: Any = None) -> dict[str, Any]:
+    """Run ``task`` and return its outcome: ``status`` (``"ok"``, ``"not_converged"`` or
+    ``"failed"``), ``error`` (None or one line), ``seconds`` and the task's results.
+
+    An error of the task itself (a bad model specification, a case the model cannot fit,
+    a solver failure) is returned as ``status = "failed"`` and stored like a result;
+    ``retry = True`` marks failures of the machine (out of memory), which are not stored.
+    ``shared`` is unused (the executor interface passes it).
+    """
+    t0 = time.perf_counter()
+    try:
+        task = dataclasses.replace(task, cases=tuple(_own_arrays(c) for c in task.cases))
+        outcome = _fit(task) if task.kind == "fit" else _diagnosis(task)
+    except InputError as err:
+        outcome = {"status": "failed", "error": str(err).replace("\n", " ")}
+    except MemoryError as err:
+        outcome = {"status": "failed", "error": f"out of memory: {err}", "retry": True}
+    except Exception as err:  # noqa: BLE001 - reported in the table, the others go on
+        outcome = {"status": "failed", "error": f"{type(err).__name__}: {err}".replace("\n", " ")}
+    outcome["seconds"] = time.perf_counter() - t0
+    return outcome
