@@ -3,8 +3,8 @@ examples, from a copy of the checkout's `examples/` in a temporary folder.
 
 Each ```bash block of the section is one test, its commands run in order by the shell; the
 first block (the fit the others read) runs once per test process. Blocks whose commands
-take over ~30 s on the 2-core CI machine are marked slow (measured: diagnose 60-90 s,
-montecarlo with an embedded Dask cluster ~40 s, ntc 25-60 s cold; the others 2-12 s)."""
+take over ~30 s on the 2-core CI machine are marked slow (measured under load: diagnose 39 s,
+montecarlo with an embedded Dask cluster 30 s, ntc 25-60 s cold; the others 2-12 s)."""
 
 import os
 import re
