@@ -123,6 +123,10 @@ def run(args: argparse.Namespace) -> int:
                          "cannot be generated as C")
     if args.planar and args.interface != "vehicle":
         raise InputError("`--planar` applies to `--interface vehicle` only")
+    if args.fmu and not has_c_compiler():
+        raise InputError(f"--fmu {args.fmu}: an FMU holds a compiled binary and no C compiler was "
+                         "found (install gcc, or set CC to one); `--out DIR` writes the C "
+                         "sources without one")
     values = read_params(args.fit) | _assignments(args.set)
     spec = args.model or _spec_of(Path(args.fit)) or BASELINE
     outputs = Outputs(overwrite=args.overwrite, inputs=[args.fit])
@@ -136,7 +140,8 @@ def run(args: argparse.Namespace) -> int:
         if args.out:
             ex = export_c(dm, paths["--out"], used, substeps=args.substeps, name=args.name,
                           overwrite=True)
-            if not args.no_build and has_c_compiler():
+            compiler = has_c_compiler()
+            if not args.no_build and compiler:
                 try:
                     ex.build()
                 except RuntimeError as err:
@@ -145,15 +150,24 @@ def run(args: argparse.Namespace) -> int:
         if args.fmu:
             from derive.fmu import export_fmu
 
-            export_fmu(dm, paths["--fmu"], used, substeps=args.substeps, max_step=args.step,
-                       name=args.name, overwrite=True)
+            try:
+                export_fmu(dm, paths["--fmu"], used, substeps=args.substeps, max_step=args.step,
+                           name=args.name, overwrite=True)
+            except RuntimeError as err:  # no compiler, or compiling failed: the compiler's words
+                raise InputError(f"--fmu {args.fmu}: {err}") from None
     if args.out:
         print(f"wrote C export of {spec} ({args.interface} interface) to {args.out}: "
               f"{ex.header.name}, {', '.join(s.name for s in ex.sources)}, {ex.driver.name}, "
               f"{ex.makefile.name}, {ex.parameters_csv.name}")
         print(f"  states: {', '.join(ex.states)}")
         print(f"  inputs: {', '.join(ex.inputs) or '(none)'}")
-        if (Path(args.out) / "simulate").exists() and not args.no_build:
+        if args.no_build:
+            print(f"  sources only (--no-build): build the driver with `make -C {args.out}`")
+        elif not compiler:
+            print(f"  note: no C compiler found (install gcc, or set CC to one): wrote the "
+                  f"sources only, not the driver `{Path(args.out) / 'simulate'}`; build it "
+                  f"where a compiler is with `make -C {args.out}`")
+        else:
             print(f"  built {Path(args.out) / 'simulate'}")
     if args.fmu:
         print(f"wrote FMU {args.fmu}")

@@ -9,20 +9,19 @@ from typing import Any
 
 import numpy as np
 
+from ._samples import MAX_LISTED_ROWS as _MAX_LISTED_ROWS
+from ._samples import check_samples, rows_text
 from .budget import decimation_hint, max_samples
-from .case import MIN_DURATION, MIN_SAMPLES, SPINNING_CHANNELS, TIME_STEP_RTOL
+from .case import SPINNING_CHANNELS
 
 __all__ = ["read_csv"]
 
 _COLUMNS_FULL = ("time", "displacement", "force")
 _COLUMNS_CRANK = ("time", "force")
-_MAX_LISTED_ROWS = 10
 
 
 def _rows_text(lines: list[int]) -> str:
-    shown = ", ".join(str(n) for n in lines[:_MAX_LISTED_ROWS])
-    more = f" and {len(lines) - _MAX_LISTED_ROWS} more" if len(lines) > _MAX_LISTED_ROWS else ""
-    return f"line{'s' if len(lines) != 1 else ''} {shown}{more}"
+    return rows_text(lines, "line")
 
 
 def _values_text(found: list[tuple[int, str]]) -> str:
@@ -165,7 +164,7 @@ def _read_rows(reader, n_lines: int, name: str, excitation: str | None, problems
                 if len(bad_fields) > _MAX_LISTED_ROWS else "")
         problems.append(f"{name}: rows: expected {ncol} comma-separated fields per row, found "
                         f"{len(bad_fields)} row(s) with a different count: {shown}{more}")
-    for j, col in enumerate(names):
+    for col in names:
         bad = bad_numbers[col]
         if bad:
             problems.append(f"{name}: column `{col}`: expected numbers, found {len(bad)} "
@@ -175,41 +174,10 @@ def _read_rows(reader, n_lines: int, name: str, excitation: str | None, problems
             problems.append(f"{name}: column `{col}`: expected plain numbers such as 1000 or "
                             f"1e3, found {len(odd)} value(s) with digit separators or non-ASCII "
                             f"digits, which only Python reads: {_values_text(odd)}")
-        skip = skip_lines | {ln for ln, _ in bad}
-        nonfinite = [int(lines[i]) for i in np.flatnonzero(~np.isfinite(data[:, j]))
-                     if int(lines[i]) not in skip]
-        if nonfinite:
-            problems.append(f"{name}: column `{col}`: expected finite numbers, found "
-                            f"{len(nonfinite)} NaN or inf value(s) at {_rows_text(nonfinite)}")
-
-    n = data.shape[0]
-    if n < MIN_SAMPLES:
-        problems.append(f"{name}: rows: expected at least {MIN_SAMPLES} samples, found {n}")
-
+    skip = {col: skip_lines | {ln for ln, _ in bad_numbers[col]} for col in names}
+    check_samples(name, names, data, problems, row=lambda i: int(lines[i]), where=_rows_text,
+                  skip=skip)
     t = data[:, 0]
-    finite_t = np.isfinite(t)
-    if n >= 2 and finite_t.all():
-        dt = np.diff(t)
-        nonincreasing = np.flatnonzero(dt <= 0.0)
-        if nonincreasing.size:
-            where = [int(lines[i + 1]) for i in nonincreasing]
-            problems.append(f"{name}: column `time`: expected strictly increasing times, found "
-                            f"{nonincreasing.size} decrease(s) or repeat(s) at {_rows_text(where)}")
-        elif n >= MIN_SAMPLES and t[-1] - t[0] < MIN_DURATION:
-            problems.append(f"{name}: column `time`: expected a record of at least "
-                            f"{MIN_DURATION:g} s (times in seconds), found {t[-1] - t[0]:.3g} s "
-                            f"({n} samples at a step of {float(np.median(dt)):.3g} s)")
-        else:
-            step = float(np.median(dt))
-            off = np.flatnonzero(np.abs(dt - step) > TIME_STEP_RTOL * step)
-            if off.size:
-                where = [int(lines[i + 1]) for i in off]
-                worst = int(off[np.argmax(np.abs(dt[off] - step))])
-                problems.append(
-                    f"{name}: column `time`: expected a uniform step (median {step:.6g} s, "
-                    f"tolerance {TIME_STEP_RTOL:g} relative), found {off.size} step(s) off at "
-                    f"{_rows_text(where)} (worst: a step of {dt[worst]:.6g} s ending at line "
-                    f"{lines[worst + 1]})")
     if len(problems) > 0:
         return None
     if spinning:

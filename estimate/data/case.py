@@ -158,7 +158,9 @@ TIME_STEP_RTOL: float = 1e-3
 
 
 class CaseError(InputError):
-    """A case file (TOML or CSV) is invalid.
+    """A case file (TOML or its data file) is invalid.
+
+    Its message is the problem when there is one, else a count and one line per problem.
 
     Parameters
     ----------
@@ -175,7 +177,10 @@ class CaseError(InputError):
     def __init__(self, problems: list[str]) -> None:
         self.problems: list[str] = list(problems)
         count = len(self.problems)
-        head = f"{count} problem{'s' if count != 1 else ''} in case:"
+        if count == 1:  # one line, as every other input error
+            super().__init__(self.problems[0])
+            return
+        head = f"{count} problems in case:"
         super().__init__("\n".join([head, *(f"  - {p}" for p in self.problems)]))
 
 

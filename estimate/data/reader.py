@@ -1,4 +1,5 @@
-"""``load_case``: a case file (TOML) and the CSV it names, validated at once."""
+"""``load_case``: a case file (TOML) and the data file it names (a CSV, or a TDMS, MAT or HDF5
+file read by :mod:`estimate.data.lab_formats`), validated at once."""
 
 from __future__ import annotations
 
@@ -11,6 +12,7 @@ from pathlib import Path
 from ._csv import read_csv
 from ._toml import Checker, read_tables, test_kind
 from .case import Case, CaseError
+from .lab_formats import LAB_SUFFIXES, is_lab_file, read_lab
 
 __all__ = ["MAX_CASE_FILE_BYTES", "load_case"]
 
@@ -33,7 +35,7 @@ def _not_a_file(path: Path) -> str | None:
 
 
 def load_case(path: str | os.PathLike[str]) -> Case:
-    """Load and validate a test case (TOML file plus the CSV it names).
+    """Load and validate a test case (TOML file plus the CSV, TDMS, MAT or HDF5 file it names).
 
     Parameters
     ----------
@@ -49,7 +51,10 @@ def load_case(path: str | os.PathLike[str]) -> Case:
     Raises
     ------
     CaseError
-        Listing every problem found in the TOML and CSV files at once.
+        Listing every problem found in the TOML and data files at once.
+    MissingDependency
+        When the data file is a TDMS, MAT or HDF5 file and the optional ``lab`` extra
+        (npTDMS, h5py, pint) is not installed.
 
     Examples
     --------
@@ -96,16 +101,25 @@ def load_case(path: str | os.PathLike[str]) -> Case:
         data_path = Path(data_name)
         if not data_path.is_absolute():
             data_path = toml_path.parent / data_path
+        lab = is_lab_file(data_path)
+        what = f"a {LAB_SUFFIXES[data_path.suffix.lower()]} file" if lab else "a CSV file"
         kind = _not_a_file(data_path)
         if kind:
-            problems.append(f"{fname}: [test] data: expected a CSV file at `{data_path}`, "
+            problems.append(f"{fname}: [test] data: expected {what} at `{data_path}`, "
                             f"found {kind}")
         elif not data_path.is_file():
-            problems.append(f"{fname}: [test] data: data file not found (expected a CSV file "
+            problems.append(f"{fname}: [test] data: data file not found (expected {what} "
                             f"at `{data_path}`)")
+        elif not lab and "data" in doc:
+            problems.append(f"{fname}: [data]: applies to TDMS, MAT and HDF5 data files "
+                            f"({', '.join(LAB_SUFFIXES)}); a CSV names its columns in its "
+                            "header (`time,displacement,force`, SI units)")
         else:
             csv_problems: list[str] = []
-            arrays = read_csv(data_path, excitation, csv_problems, rig_kind)
+            if lab:
+                arrays = read_lab(data_path, fname, doc, excitation, rig_kind, rig, csv_problems)
+            else:
+                arrays = read_csv(data_path, excitation, csv_problems, rig_kind)
             problems.extend(csv_problems)
             if arrays is not None and rig is not None:
                 from .spin import spin_column_problems
