@@ -160,9 +160,12 @@ from estimate.interrupts import handled, temporary
 tmp = Path(sys.argv[1])
 tmp.write_text("partial")
 with handled("slosh stuck"), temporary([tmp]):
-    print("ready", flush=True)
+    ready = False
     while True:  # code that swallows every interrupt, like a native loop that never returns
         try:
+            if not ready:  # announced inside the try: a signal right after it is swallowed too
+                print("ready", flush=True)
+                ready = True
             time.sleep(0.05)
         except KeyboardInterrupt:
             pass

@@ -164,6 +164,7 @@ def test_open_diagnosis(name, tmp_path):
     check(RECORDS[name], d)
 
 
+@pytest.mark.slow  # 30 s: the reference integrates a friction sign sharpened to 1e-3 rad/s
 def test_friction_records_halve_their_equivalent_damping():
     """The friction records do what they claim: the swing doubles from step to step (so the
     equivalent damping ratio of Coulomb friction, 2 Tc / (pi m L^2 w^2 a), halves)."""
