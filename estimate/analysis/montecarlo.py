@@ -264,7 +264,8 @@ class MonteCarloResult:
             ax[1].fill_between(t, env[lo], env[hi], alpha=alpha, color="#2166ac", lw=0,
                                label=f"draws, {lo:g}-{hi:g} %")
         ax[1].plot(t, env[50.0], color="#2166ac", lw=0.8, label="draws, median")
-        limit = style.robust_limit(np.concatenate([env[qs[0]], env[qs[-1]]]), margin=1.2)
+        # the bands are percentiles already: their largest excursion sets the axis
+        limit = 1.15 * float(np.max(np.abs([env[qs[0]], env[qs[-1]]]))) or 1.0
         if measured is not None:
             mdev = np.asarray(measured, float) - nominal
             ax[1].plot(t, mdev, color="0.2", lw=0.6, label="measured - nominal", zorder=3)

@@ -128,6 +128,7 @@ def _plot(args: argparse.Namespace, tank, liquid: Liquid, path: str, pred) -> No
     fig.suptitle(f"{args.shape}, radius {args.radius:g} m, height {tank.height:.4g} m; "
                  f"{liquid.density:g} kg/m^3, g = {args.gravity:g} m/s^2; method {args.method}")
     fig.savefig(path, dpi=120)
+    return fig
 
 
 def run(args: argparse.Namespace) -> int:

@@ -155,8 +155,12 @@ def before_after_figure(d: Diagnosis, path: str | Path | None = None):
         ax[0].indicate_inset_zoom(inset, edgecolor="0.4")
     ax[0].legend(loc="lower left", bbox_to_anchor=(0, 1.0), ncols=3, fontsize="small", frameon=False)
     steady = t > end
-    limit = max(style.robust_limit(d.baseline.residuals[0], steady),
-                style.robust_limit(d.final.residuals[0], steady))
+
+    def fitted(res: FitResult) -> np.ndarray:  # after the start-up, not held out
+        return steady & (res.weights[0] > 0) if res.weights else steady
+
+    limit = max(style.robust_limit(d.baseline.residuals[0], fitted(d.baseline)),
+                style.robust_limit(d.final.residuals[0], fitted(d.final)))
     noise = d.baseline_evidence.noise_rms
     for a, res, name in ((ax[1], d.baseline, "baseline"), (ax[2], d.final, "final")):
         r = res.residuals[0]
@@ -167,10 +171,11 @@ def before_after_figure(d: Diagnosis, path: str | Path | None = None):
                 a.axvspan(lo, hi, color="#fee08b", alpha=0.35, lw=0, zorder=0,
                           label="held out of the fit" if i == 0 else None)
         style.mark_startup(a, t, np.abs(r), end, limit, "N")
-        rms = float(np.sqrt(np.mean(r[steady] ** 2)))
+        rms = float(np.sqrt(np.mean(r[fitted(res)] ** 2)))
         a.set(ylabel="residual [N]", ylim=(-limit, limit))
         a.set_title(f"{name} ({_model_text(res)}): RMS residual {res.rms_residual:.3g} N "
-                    f"({rms:.3g} N after the start-up)", fontsize="medium", loc="left")
+                    f"({rms:.3g} N on the fitted samples after the start-up)", fontsize="medium",
+                    loc="left")
         a.legend(loc="upper right", fontsize="small", ncols=3)
     ax[2].set_xlabel("time [s]")
     fig.suptitle(f"Diagnosis of {d.baseline.problem.experiments[0].case.test.id}: before and after")
