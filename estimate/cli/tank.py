@@ -125,8 +125,9 @@ def _plot(args: argparse.Namespace, tank, liquid: Liquid, path: str, pred) -> No
     top.set_xlabel("fill [% of tank volume]")
     for a in ax:
         a.legend(loc="best", fontsize="small")
-    fig.suptitle(f"{args.shape}, radius {args.radius:g} m, height {tank.height:.4g} m; "
-                 f"{liquid.density:g} kg/m^3, g = {args.gravity:g} m/s^2; method {args.method}")
+    fig.suptitle(f"{args.shape}, radius {args.radius:g} m, height {tank.height:.4g} m\n"
+                 f"{liquid.density:g} kg/m^3, g = {args.gravity:g} m/s^2, method {args.method}",
+                 fontsize="medium")
     fig.savefig(path, dpi=120)
     return fig
 
