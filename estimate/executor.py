@@ -20,8 +20,10 @@ class Executor:
     """Runs ``fn(item, shared=shared)`` for each of ``items`` and returns the results in
     order; ``shared`` (large data all tasks need) is sent to each worker once."""
 
-    def map(self, fn: Callable[[Any, Any], Any], items: Sequence[Any], shared: Any = None
-            ) -> list[Any]:
+    def map(self, fn: Callable[[Any, Any], Any], items: Sequence[Any], shared: Any = None,
+            *, done: Callable[[], None] | None = None) -> list[Any]:
+        """``[fn(item, shared=shared) for item in items]``, in order; ``done()`` is called
+        (in this process) as each task finishes, for progress bars."""
         raise NotImplementedError
 
     def as_completed(self, fn: Callable[[Any, Any], Any], items: Sequence[Any],
@@ -65,14 +67,20 @@ class LocalExecutor(Executor):
     def __init__(self, threads: int | None = None) -> None:
         self.threads = max(1, int(threads if threads is not None else (os.cpu_count() or 1)))
 
-    def map(self, fn: Callable[[Any, Any], Any], items: Sequence[Any], shared: Any = None
-            ) -> list[Any]:
+    def map(self, fn: Callable[[Any, Any], Any], items: Sequence[Any], shared: Any = None,
+            *, done: Callable[[], None] | None = None) -> list[Any]:
+        def one(item):
+            out = fn(item, shared=shared)
+            if done is not None:
+                done()
+            return out
+
         if self.threads == 1 or len(items) < 2:
-            return [fn(item, shared=shared) for item in items]
+            return [one(item) for item in items]
         from concurrent.futures import ThreadPoolExecutor
 
         with ThreadPoolExecutor(self.threads) as pool:
-            return list(pool.map(lambda item: fn(item, shared=shared), items))
+            return list(pool.map(one, items))
 
     def as_completed(self, fn: Callable[[Any, Any], Any], items: Sequence[Any],
                      shared: Any = None) -> Iterator[tuple[int, Any]]:
@@ -145,10 +153,13 @@ class DaskExecutor(Executor):
     def workers(self) -> int:
         return max(1, len(self.client.scheduler_info().get("workers", {})))
 
-    def map(self, fn: Callable[[Any, Any], Any], items: Sequence[Any], shared: Any = None
-            ) -> list[Any]:
+    def map(self, fn: Callable[[Any, Any], Any], items: Sequence[Any], shared: Any = None,
+            *, done: Callable[[], None] | None = None) -> list[Any]:
         data = self.client.scatter(shared, broadcast=True) if shared is not None else None
         futures = self.client.map(fn, list(items), shared=data, pure=False)
+        if done is not None:
+            for _ in _import_distributed().as_completed(futures):
+                done()
         return self.client.gather(futures)
 
     def as_completed(self, fn: Callable[[Any, Any], Any], items: Sequence[Any],

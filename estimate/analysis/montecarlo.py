@@ -159,9 +159,10 @@ def _run_task(task: _Task, shared: str) -> np.ndarray:
 class MonteCarloResult:
     """Envelopes and summaries of a Monte Carlo run.
 
-    ``outputs[name]`` is ``(samples, len(time))``; ``envelopes[name][q]`` the ``q``-th
-    percentile over draws at each time; ``derived[name]`` per draw (``peak_<output>`` is
-    the largest magnitude over the run, ``pN.frequency_hz`` and ``pN.damping_ratio`` from
+    ``outputs[name]`` is ``(samples, len(time))``; ``nominal[name]`` the output at the fit's
+    values; ``envelopes[name][q]`` the ``q``-th percentile over draws at each time;
+    ``derived[name]`` per draw (``peak_<output>`` is the largest magnitude over the run,
+    ``pN.frequency_hz`` and ``pN.damping_ratio`` from
     the drawn parameters).
     """
 
@@ -175,6 +176,8 @@ class MonteCarloResult:
     seconds: float
     executor: str
     percentiles: tuple[float, ...] = PERCENTILES
+    #: Per output, the simulation at the fit's values (the nominal), ``(len(time),)``.
+    nominal: Mapping[str, np.ndarray] = field(default_factory=dict)
 
     @property
     def samples(self) -> int:
@@ -226,30 +229,51 @@ class MonteCarloResult:
             lines.append(f"{name:<22}{s['mean']:>11.5g}  {s['std']:>11.4g}  {vals}")
         return "\n".join(lines)
 
-    def plot(self, path: str | Path | None = None, *, output: str | None = None):
-        """Median and percentile bands of ``output`` (default: the first) over time."""
-        import matplotlib
+    def plot(self, path: str | Path | None = None, *, output: str | None = None,
+             measured: np.ndarray | None = None):
+        """What the parameter uncertainty does to ``output`` (default: the first).
 
-        if path is not None:
-            matplotlib.use("Agg", force=False)
-        import matplotlib.pyplot as plt
+        Top: the nominal simulation (fit values) over the ``measured`` trace when given, with
+        a zoom on the record's end. Bottom: the percentile bands of the deviation of the
+        draws from the nominal (the part the uncertainty moves, invisible on the full force
+        scale) and the measured trace's deviation from the nominal on the same axis.
+        Saves to ``path`` when given; returns the figure."""
+        from .. import _plotting as style
 
         name = output or next(iter(self.outputs))
-        env = self.envelopes[name]
-        fig, ax = plt.subplots(figsize=(9, 4))
+        unit = style.unit_of(name) if name.startswith(("force", "torque")) else "-"
+        t = self.time
+        Y = self.outputs[name]
+        nominal = self.nominal.get(name)
+        if nominal is None:  # a result made without the nominal run: the median stands in
+            nominal = np.median(Y, axis=0)
+            nominal_label = "median of the draws"
+        else:
+            nominal_label = "nominal (fit values)"
+        dev = np.percentile(Y - nominal, self.percentiles, axis=0)
+        env = dict(zip(self.percentiles, dev))
+        fig = style.figure(path, figsize=(10, 7))
+        ax = fig.subplots(2, 1, sharex=True, height_ratios=[1.2, 1])
+        if measured is not None:
+            ax[0].plot(t, measured, **style.MEASURED, label="measured (filtered)")
+        ax[0].plot(t, nominal, **style.SIMULATED, label=nominal_label)
+        ax[0].set(ylabel=f"{name} [{unit}]", xlim=(t[0], t[-1]))
+        ax[0].legend(loc="lower left", bbox_to_anchor=(0, 1.0), ncols=2, fontsize="small", frameon=False)
         qs = sorted(self.percentiles)
-        for lo, hi, alpha in ((qs[0], qs[-1], 0.25), (qs[1], qs[-2], 0.4)):
-            ax.fill_between(self.time, env[lo], env[hi], alpha=alpha, color="C0", lw=0,
-                            label=f"{lo:g}-{hi:g} %")
-        ax.plot(self.time, env[50.0], color="C0", lw=1, label="median")
-        ax.set_xlabel("time (s)")
-        ax.set_ylabel(f"{name} (N)" if name.startswith("force") else name)
-        ax.set_title(f"Monte Carlo envelope, {self.samples} draws")
-        ax.legend(loc="upper right")
-        fig.tight_layout()
-        if path is not None:
-            fig.savefig(path, dpi=120)
-            plt.close(fig)
+        for lo, hi, alpha in ((qs[0], qs[-1], 0.25), (qs[1], qs[-2], 0.45)):
+            ax[1].fill_between(t, env[lo], env[hi], alpha=alpha, color="#2166ac", lw=0,
+                               label=f"draws, {lo:g}-{hi:g} %")
+        ax[1].plot(t, env[50.0], color="#2166ac", lw=0.8, label="draws, median")
+        # the bands are percentiles already: their largest excursion sets the axis
+        limit = 1.15 * float(np.max(np.abs([env[qs[0]], env[qs[-1]]]))) or 1.0
+        if measured is not None:
+            mdev = np.asarray(measured, float) - nominal
+            ax[1].plot(t, mdev, color="0.2", lw=0.6, label="measured - nominal", zorder=3)
+            limit = max(limit, style.robust_limit(mdev, t > style.startup_end(t), margin=1.1))
+        ax[1].set(ylabel=f"{name} - nominal [{unit}]", xlabel="time [s]", ylim=(-limit, limit))
+        ax[1].legend(loc="upper right", fontsize="small", ncols=2)
+        fig.suptitle(f"Monte Carlo over the fit's uncertainty: {self.samples} draws (seed {self.seed})")
+        style.save(fig, path, dpi=120)
         return fig
 
 
@@ -276,7 +300,8 @@ class MonteCarlo:
         return tuple(self.outputs or self.derived.measured)
 
     def run(self, samples: int, *, seed: int | None = 0, executor: Executor | None = None,
-            batch_size: int = 256, compile: bool = True) -> MonteCarloResult:
+            batch_size: int = 256, compile: bool = True,
+            progress: bool | None = None) -> MonteCarloResult:
         """Draw ``samples`` parameter sets and simulate them in batches of ``batch_size``.
 
         Parameters
@@ -291,6 +316,8 @@ class MonteCarlo:
             Draws per batch (one mapped CasADi function; the last batch is padded).
         compile : bool, default True
             Compile the batch function to C (cached on disk) when a compiler exists.
+        progress : bool, optional
+            Show a bar of the finished batches; default: on a terminal only.
         """
         start = _time.perf_counter()
         executor = executor or LocalExecutor()
@@ -306,31 +333,36 @@ class MonteCarlo:
         base = self.base_vector()
         draws, acceptance = draw_parameters(self.fit, samples, seed=seed)
         cols = [dm.parameter_names.index(n) for n in self.fit.covariance_names]
-        P = np.tile(np.nan_to_num(base), (samples, 1))
-        P[:, cols] = draws
+        # the draws, then the nominal (the fit's values) as one more column
+        P = np.tile(np.nan_to_num(base), (samples + 1, 1))
+        P[:samples, cols] = draws
         t = np.asarray(self.time, float)
         exc = self.excitation if self.excitation is not None else NoExcitation(size=dm.nu)
-        batch = max(1, min(batch_size, samples))
+        batch = max(1, min(batch_size, samples + 1))
         fn = _batch_function(dm, t, exc, np.zeros(dm.nx), tuple(dm.output_index(n) for n in names),
                              batch)
         text = fn.serialize()
         key = hashlib.sha256(text.encode()).hexdigest()[:24]
         tasks = []
-        for a, b in chunks(samples, batch):
+        for a, b in chunks(samples + 1, batch):
             Pb = P[a:b]
             if Pb.shape[0] < batch:
                 Pb = np.vstack([Pb, np.repeat(Pb[-1:], batch - Pb.shape[0], axis=0)])
             tasks.append(_Task(key, np.ascontiguousarray(Pb.T), compile))
-        results = executor.map(_run_task, tasks, shared=text)
-        Y = np.vstack(results)[:samples]  # (samples, len(names) * (n + 1)), output by output
+        from .._progress import progress as bar
+
+        with bar(total=len(tasks), desc="Monte Carlo", unit="batch", enabled=progress) as b:
+            results = executor.map(_run_task, tasks, shared=text, done=b.update)
+        Y = np.vstack(results)[:samples + 1]  # (samples + 1, len(names) * (n + 1)), output by output
         nt = t.size
-        outputs = {name: Y[:, i * nt:(i + 1) * nt] for i, name in enumerate(names)}
+        outputs = {name: Y[:samples, i * nt:(i + 1) * nt] for i, name in enumerate(names)}
+        nominal = {name: Y[samples, i * nt:(i + 1) * nt] for i, name in enumerate(names)}
         derived = {f"peak_{name}": np.max(np.abs(v), axis=1) for name, v in outputs.items()}
-        derived |= derived_quantities(dm, P)
+        derived |= derived_quantities(dm, P[:samples])
         return MonteCarloResult(
             time=t, parameter_names=self.fit.covariance_names, draws=draws, outputs=outputs,
             derived=derived, seed=seed, acceptance=acceptance,
-            seconds=_time.perf_counter() - start,
+            seconds=_time.perf_counter() - start, nominal=nominal,
             executor=f"{type(executor).__name__} ({executor.workers} worker"
                      f"{'s' if executor.workers > 1 else ''})")
 
@@ -357,7 +389,7 @@ def monte_carlo(derived: DerivedModel, time: np.ndarray, excitation: Excitation 
                 fit: Fit, samples: int, *, fixed: Mapping[str, float] | None = None,
                 outputs: Sequence[str] | None = None, seed: int | None = 0,
                 executor: Executor | None = None, batch_size: int = 256,
-                compile: bool = True) -> MonteCarloResult:
+                compile: bool = True, progress: bool | None = None) -> MonteCarloResult:
     """Run :class:`MonteCarlo` in one call; see :meth:`MonteCarlo.run`.
 
     Examples
@@ -374,4 +406,4 @@ def monte_carlo(derived: DerivedModel, time: np.ndarray, excitation: Excitation 
     problem = MonteCarlo(derived, np.asarray(time, float), excitation, fit, dict(fixed or {}),
                          tuple(outputs) if outputs else None)
     return problem.run(samples, seed=seed, executor=executor, batch_size=batch_size,
-                       compile=compile)
+                       compile=compile, progress=progress)

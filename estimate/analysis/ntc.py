@@ -207,6 +207,7 @@ def nutation_time_constant(
     samples_per_period: int = 40,
     fit_start: float = 0.15,
     integrator: Adaptive = Adaptive(rtol=1e-10, atol=1e-14),
+    progress: bool | None = None,
 ) -> NutationTimeConstant:
     """NTC of a :class:`~analogs.spacecraft.FreeSpacecraft` model, simulated and linearised.
 
@@ -228,6 +229,9 @@ def nutation_time_constant(
         Fraction of ``duration`` skipped before the fit (faster analog modes decay there).
     integrator : Adaptive
         CVODES settings of the nonlinear simulation.
+    progress : bool, optional
+        Show a bar of the stages (derive, steady spin, linearise, simulate); default: on a
+        terminal only.
 
     Examples
     --------
@@ -241,7 +245,19 @@ def nutation_time_constant(
     >>> ntc.grows  # oblate spinner with an energy sink: nutation decays
     False
     """
-    dm = derive(model) if isinstance(model, Model) else model
+    from .._progress import progress as bar
+
+    with bar(total=4, desc="NTC", unit="stage", enabled=progress) as b:
+        b.set_postfix_str("deriving the equations")
+        dm = derive(model) if isinstance(model, Model) else model
+        b.update()
+        return _ntc(dm, params, duration, initial_rate, samples_per_period, fit_start, integrator,
+                    b)
+
+
+def _ntc(dm: DerivedModel, params: Mapping[str, float] | None, duration: float | None,
+         initial_rate: float | None, samples_per_period: int, fit_start: float,
+         integrator: Adaptive, bar) -> NutationTimeConstant:
     rig = _spacecraft(dm)
     p = dm.parameter_vector(params)
     pv = dict(zip(dm.parameter_names, p))
@@ -257,8 +273,12 @@ def nutation_time_constant(
     eps = 1e-4 * abs(spin) if initial_rate is None else float(initial_rate)
 
     # linearised
+    bar.set_postfix_str("steady spin")
     eq = steady_spin(dm, params)
+    bar.update()
+    bar.set_postfix_str("linearising")
     A, x_eq = linearize(dm, params, eq)
+    bar.update()
     w, V = np.linalg.eig(A)
     kick = np.zeros(dm.nx)
     kick[dm.states.index(f"{rig.name}.phi_dot")] = eps
@@ -272,7 +292,9 @@ def nutation_time_constant(
     # nonlinear simulation and envelope fit
     n = int(np.ceil(duration / period * samples_per_period))
     t = np.linspace(0.0, duration, n + 1)
+    bar.set_postfix_str(f"simulating {duration:.0f} s")
     sim = simulate(dm, params, t, integrator=integrator, x0=x_eq + kick)
+    bar.update()
     s = {nm: sim.state(f"{rig.name}.{nm}") for nm in ("phi", "theta", "psi", "phi_dot",
                                                        "theta_dot", "psi_dot")}
     wx, wy, _ = body_angular_velocity(s["phi"], s["theta"], s["psi"], s["phi_dot"],

@@ -69,7 +69,19 @@ def run(args: argparse.Namespace) -> int:
     data = {"fit": str(args.fit), "case": str(args.case), **res.to_json()}
     with outputs.writing() as paths:
         paths["--out montecarlo.json"].write_text(json_text(data, indent=1))
-        res.plot(paths["--out envelope.png"])
+        res.plot(paths["--out envelope.png"], measured=_measured(exp, res))
     print(res.report())
     print(f"wrote {files['montecarlo.json']} and {files['envelope.png']}")
     return 0
+
+
+def _measured(exp, res):
+    """The case's measurement of the plotted output, low-passed as the fit saw it (the
+    10 Hz force filter), or None when the case does not measure it."""
+    from ..data.signals import lowpass
+    from ..fitting.problem import FILTERED_FORCE_CUTOFF_HZ
+
+    raw = exp.case.channels.get(next(iter(res.outputs)))
+    if raw is None:
+        return None
+    return lowpass(exp.case.time, raw, cutoff_hz=FILTERED_FORCE_CUTOFF_HZ)

@@ -55,32 +55,81 @@ def _tank(args: argparse.Namespace):
     return Capsule(args.radius, args.length)
 
 
-def _plot(args: argparse.Namespace, tank, liquid: Liquid, path: str) -> None:
-    import matplotlib
+#: Legacy Lomen basis: where the prediction's note says it has not converged (fill above).
+_LEGACY_CONVERGED_UP_TO = 0.5
 
-    matplotlib.use("Agg")
-    import matplotlib.pyplot as plt
+
+def _spans(x, flag) -> list[tuple[float, float]]:
+    """Contiguous ranges of ``x`` (uniform) where ``flag`` holds, widened by half a step."""
     import numpy as np
 
+    step = float(np.median(np.diff(x))) if len(x) > 1 else 1.0
+    edges = np.flatnonzero(np.diff(np.r_[0, np.asarray(flag, int), 0]))
+    return [(float(x[a]) - step / 2, float(x[b - 1]) + step / 2) for a, b in zip(edges[::2], edges[1::2])]
+
+
+def _plot(args: argparse.Namespace, tank, liquid: Liquid, path: str, pred) -> None:
+    import numpy as np
+    from matplotlib.figure import Figure
+
+    from .. import _plotting as style
+    from .._progress import progress
+
     fills = np.linspace(0.05, 0.95, 19)
-    rows = [predict(tank, fill=float(f), liquid=liquid, gravity=args.gravity,
-                    method=args.method, modes=args.modes) for f in fills]
-    fig, (ax1, ax2) = plt.subplots(2, 1, sharex=True, figsize=(6.4, 6.4))
-    ax1.plot(100 * fills, [r.fixed_mass.mass for r in rows], "k-o", ms=3, label="fixed mass")
-    ax1.plot(100 * fills, [sum(m.mass for m in r.modes) for r in rows], "b-s", ms=3,
-             label="slosh mass (kept modes)")
-    ax1.set_ylabel("mass [kg]")
-    ax1.legend()
+    rows = []
+    with progress(total=fills.size, desc="tank plot", unit="fill") as bar:
+        for f in fills:
+            rows.append(predict(tank, fill=float(f), liquid=liquid, gravity=args.gravity,
+                                method=args.method, modes=args.modes))
+            bar.update()
+    pct = 100 * fills
+    fig = Figure(figsize=(7.5, 8.5), layout="constrained")
+    ax = fig.subplots(3, 1, sharex=True, height_ratios=[1.2, 1, 0.8])
+    ax[0].plot(pct, [r.liquid_mass for r in rows], color="0.6", ls=":", lw=1.2, label="liquid mass")
+    ax[0].plot(pct, [r.fixed_mass.mass for r in rows], "k-o", ms=3, label="fixed mass")
     for n in range(args.modes):
-        ax2.plot(100 * fills, [r.modes[n].frequency_hz for r in rows], "-o", ms=3,
-                 label=f"mode {n + 1}")
-    ax2.set_ylabel("frequency [Hz]")
-    ax2.set_xlabel("fill [% of tank height]")
-    ax2.legend()
-    ax1.set_title(f"{tank!r}, {args.method}")
-    fig.tight_layout()
+        ax[0].plot(pct, [r.modes[n].mass for r in rows], "-s", ms=3, color=f"C{n}",
+                   label=f"slosh mass, mode {n + 1}")
+        ax[1].plot(pct, [r.modes[n].frequency_hz for r in rows], "-s", ms=3, color=f"C{n}",
+                   label=f"mode {n + 1}")
+    ax[0].set_ylabel("mass [kg]")
+    ax[1].set_ylabel("frequency [Hz]")
+    zeta = np.array([r.modes[0].damping_ratio for r in rows])
+    ax[2].plot(pct, zeta, "-o", ms=3, color="C2", label="damping ratio (all modes)")
+    ax[2].set(ylabel="damping ratio [-]", xlabel="fill [% of tank height]", xlim=(0, 100))
+    # what the reader should not trust: the legacy basis above half full, damping outside
+    # its correlation's data
+    if args.method == "legacy":
+        for a in ax[:2]:
+            a.axvspan(100 * _LEGACY_CONVERGED_UP_TO, 100, **style.DISCOUNT,
+                      label="legacy basis not converged")
+    invalid = np.array([any("validity range" in n for n in r.notes) for r in rows])
+    for i, (lo, hi) in enumerate(_spans(pct, invalid)):
+        ax[2].axvspan(lo, hi, **style.DISCOUNT, label="outside the correlation's data" if i == 0 else None)
+    # the requested fill, with the prediction there
+    req = 100 * pred.fill_fraction
+    for i, a in enumerate(ax):
+        a.axvline(req, color="#b2182b", lw=1.2, ls="--", gid="requested fill",
+                  label=f"requested fill {req:.3g} %" if i == 0 else None)
+    ax[0].plot([req] * (1 + args.modes), [pred.fixed_mass.mass, *(m.mass for m in pred.modes)], "D",
+               color="#b2182b", ms=6, zorder=4)
+    ax[1].plot([req] * args.modes, [m.frequency_hz for m in pred.modes], "D", color="#b2182b", ms=6,
+               zorder=4)
+    ax[1].annotate(f"{pred.modes[0].frequency_hz:.3g} Hz", (req, pred.modes[0].frequency_hz),
+                   xytext=(6, -4), textcoords="offset points", color="#b2182b", fontsize="small")
+    # volume fill on the top axis (monotone in the height fill)
+    grid = np.linspace(0.0, 1.0, 401)
+    vol = np.array([tank.volume(g * tank.height) for g in grid]) / tank.volume()
+    top = ax[0].secondary_xaxis("top", functions=(lambda x: 100 * np.interp(x / 100, grid, vol),
+                                                  lambda v: 100 * np.interp(v / 100, vol, grid)))
+    top.set_xlabel("fill [% of tank volume]")
+    for a in ax:
+        a.legend(loc="best", fontsize="small")
+    fig.suptitle(f"{args.shape}, radius {args.radius:g} m, height {tank.height:.4g} m\n"
+                 f"{liquid.density:g} kg/m^3, g = {args.gravity:g} m/s^2, method {args.method}",
+                 fontsize="medium")
     fig.savefig(path, dpi=120)
-    plt.close(fig)
+    return fig
 
 
 def run(args: argparse.Namespace) -> int:
@@ -100,5 +149,5 @@ def run(args: argparse.Namespace) -> int:
         if args.json:
             paths["--json"].write_text(json_text({**pred.to_dict(), "notes": list(pred.notes)}))
         if args.plot:
-            _plot(args, tank, liquid, paths["--plot"])
+            _plot(args, tank, liquid, paths["--plot"], pred)
     return 0

@@ -11,7 +11,7 @@ import numpy as np
 from scipy import signal
 from scipy.stats import chi2
 
-from ..data.signals import find_spectral_peaks, welch_spectrum
+from ..data.signals import drive_frequency, find_spectral_peaks, welch_spectrum
 from ..fitting.result import FitResult
 
 __all__ = ["Evidence", "ResidualPeak", "SegmentDamping", "Trend", "amplitude_trend",
@@ -188,20 +188,6 @@ def noise_floor(time: np.ndarray, force: np.ndarray, cutoff_hz: float | None) ->
     return math.sqrt(level * min(cut, fs / 2))
 
 
-def _drive(t: np.ndarray, acc: np.ndarray) -> tuple[float | None, bool]:
-    """Dominant excitation frequency, and whether the drive sweeps (broad spectrum)."""
-    spec = welch_spectrum(t, acc)
-    p = spec.psd
-    if not np.any(p > 0):
-        return None, False
-    main = spec.frequency[int(np.argmax(p))]
-    # share of acceleration power within +/-10 % of the dominant frequency
-    near = np.abs(spec.frequency - main) <= 0.1 * main + 2 * spec.resolution
-    sweep = float(p[near].sum() / p.sum()) < 0.7
-    peaks = find_spectral_peaks(t, acc, min_frequency=0.5 * main, max_frequency=1.5 * main, max_peaks=1)
-    return (peaks[0].frequency if peaks else float(main)), sweep
-
-
 def _ljung_box(r: np.ndarray, lags: int = 20) -> tuple[float, float]:
     r = r - r.mean()
     n = r.size
@@ -229,8 +215,8 @@ def collect_evidence(result: FitResult, *, case: int = 0, segments: tuple[Segmen
     meas = result.measured[case]
     w = result.weights[case] if result.weights else np.ones_like(res)
     keep = w > 0
-    acc = _carriage_acceleration(result, case)
-    drive, sweep = _drive(t, acc) if acc is not None else (None, False)
+    acc = result.drive_acceleration(case)
+    drive, sweep = drive_frequency(t, acc) if acc is not None else (None, False)
     amp = float(np.sqrt(2) * np.std(meas))
     peaks = []
     rr = np.where(keep, res, 0.0)
@@ -302,18 +288,6 @@ def _multichannel_evidence(result: FitResult, case: int) -> Evidence:
         drive_frequency=None, sweep=False, peaks=(), harmonics={}, ljung_box_q=q,
         ljung_box_p=pval, skew_correlation=0.0, skew_delay=0.0, frequency_ratio=None,
         pinned=pinned, channel_share={c: float(p / total) for c, p in zip(chans, power)})
-
-
-def _carriage_acceleration(result: FitResult, case: int) -> np.ndarray | None:
-    if result.carriage and result.carriage[case] is not None:
-        return np.asarray(result.carriage[case])[2]  # the estimated carriage motion
-    exp = result.problem.experiments[case]
-    dm = exp.derived
-    t = np.asarray(exp.case.time, float)
-    if dm.nu and "rig.x_ddot" in dm.inputs:
-        return exp.excitation.values(t)[dm.inputs.index("rig.x_ddot")]
-    # crank drive: the rigid-body part of the simulated force, divided by the rigid mass
-    return None
 
 
 def segment_damping(result: FitResult, *, case: int = 0, n_segments: int = 4,

@@ -7,25 +7,18 @@ from pathlib import Path
 
 import numpy as np
 
+from .. import _plotting as style
 from ..data.signals import welch_spectrum
+from ..fitting.plots import drive_frequency_of, mode_frequencies, noise_density, spectrum_top
 from ..fitting.result import FitResult
 from ..outputs import json_text
 from .outcome import Diagnosis
 
-__all__ = ["REPORT_FILES", "write_report", "summary"]
+__all__ = ["REPORT_FILES", "write_report", "summary", "before_after_figure", "residual_spectra_figure"]
 
 #: The files :func:`write_report` writes into its folder.
 REPORT_FILES = ("summary.md", "diagnosis.json", "fit_before_after.png", "residual_spectra.png",
                 "parameters.md")
-
-
-def _pyplot():
-    import matplotlib
-
-    matplotlib.use("Agg")
-    import matplotlib.pyplot as plt
-
-    return plt
 
 
 def _parameter_rows(res: FitResult) -> list[str]:
@@ -107,28 +100,10 @@ def write_report(d: Diagnosis, folder: str | Path, *, overwrite: bool = False) -
     if existing and not overwrite:
         raise FileExistsError(f"{folder} already holds {', '.join(existing)}; pass overwrite")
     folder.mkdir(parents=True, exist_ok=True)
-    plt = _pyplot()
-    t = d.baseline.problem.experiments[0].case.time
-    fig, ax = plt.subplots(2, 1, figsize=(10, 7), sharex=True, constrained_layout=True)
-    for a, res, title in ((ax[0], d.baseline, "baseline"), (ax[1], d.final, "final")):
-        a.plot(t, res.measured[0], lw=0.7, label="measured (filtered)")
-        a.plot(t, res.simulated(0), lw=0.7, label=f"simulated ({' + '.join(res.problem.model.names)})")
-        a.plot(t, res.residuals[0], lw=0.6, color="C3", label="residual")
-        a.set(ylabel="force [N]", title=f"{title}: RMS residual {res.rms_residual:.3g} N")
-        a.legend(loc="upper right", fontsize="small")
-    ax[1].set(xlabel="time [s]")
-    fig.savefig(folder / "fit_before_after.png", dpi=100)
-    plt.close(fig)
-    fig, ax = plt.subplots(figsize=(9, 4.5), constrained_layout=True)
-    for res, label in ((d.baseline, "baseline residual"), (d.final, "final residual")):
-        sp = welch_spectrum(t, res.residuals[0])
-        ax.semilogy(sp.frequency, np.sqrt(sp.psd), label=label)
-    for p in d.baseline_evidence.peaks:
-        ax.axvline(p.frequency, color="0.6", ls=":", lw=0.8)
-    ax.set(xlabel="frequency [Hz]", ylabel="amplitude density [N/sqrt(Hz)]", xlim=(0, 15))
-    ax.legend()
-    fig.savefig(folder / "residual_spectra.png", dpi=100)
-    plt.close(fig)
+    style.save(before_after_figure(d, folder / "fit_before_after.png"), folder / "fit_before_after.png",
+               dpi=100)
+    style.save(residual_spectra_figure(d, folder / "residual_spectra.png"),
+               folder / "residual_spectra.png", dpi=100)
     (folder / "parameters.md").write_text("\n".join(["# Baseline", ""] + _parameter_rows(d.baseline)
                                                     + ["", "# Final", ""] + _parameter_rows(d.final)) + "\n")
     (folder / "summary.md").write_text(summary(d))
@@ -140,3 +115,118 @@ def _drive_text(ev) -> str:
     if ev.sweep:
         return "a frequency sweep"
     return f"{ev.drive_frequency:.4g} Hz" if ev.drive_frequency else "crank"
+
+
+def _model_text(res: FitResult) -> str:
+    return " + ".join(res.problem.model.names)
+
+
+def before_after_figure(d: Diagnosis, path: str | Path | None = None):
+    """The measured force with the baseline's and the final model's simulation (zooms on the
+    start-up and the steady end), and the two residuals on their own, shared axis in N
+    scaled by the baseline residual after the start-up (the start-up shaded), with the
+    measurement noise as a band. ``path`` only decides how the figure is made (saved:
+    without pyplot); returns the figure."""
+    t = np.asarray(d.baseline.problem.experiments[0].case.time, float)
+    meas = d.baseline.measured[0]
+    base, final = d.baseline.simulated(0), d.final.simulated(0)
+    fig = style.figure(path, figsize=(10, 8.5))
+    ax = fig.subplots(3, 1, sharex=True, height_ratios=[2.2, 1, 1])
+    ax[0].plot(t, meas, **style.MEASURED, label="measured (filtered)")
+    base_style = {**style.SIMULATED, "color": "#e08214", "ls": (0, (2, 1.5))}
+    final_style = {**style.SIMULATED, "ls": "-"}
+    ax[0].plot(t, base, **base_style, label=f"baseline ({_model_text(d.baseline)})")
+    ax[0].plot(t, final, **final_style, label=f"final ({_model_text(d.final)})")
+    top = float(np.max(np.abs(meas))) or 1.0
+    ax[0].set(ylabel="force_x [N]", ylim=(-1.1 * top, 2.9 * top), xlim=(t[0], t[-1]))
+    ax[0].set_yticks([tk for tk in ax[0].get_yticks() if abs(tk) <= 1.1 * top])
+    end = style.startup_end(t)
+    span = max(1.0, 0.06 * (t[-1] - t[0]), end - t[0])
+    for (lo, hi), bounds, name in (((t[0], t[0] + span), [0.04, 0.6, 0.42, 0.38], "start-up"),
+                                   ((t[-1] - span, t[-1]), [0.54, 0.6, 0.42, 0.38], "steady")):
+        inset = ax[0].inset_axes(bounds)
+        keep = (t >= lo) & (t <= hi)
+        inset.plot(t[keep], meas[keep], **style.MEASURED)
+        inset.plot(t[keep], base[keep], **base_style)
+        inset.plot(t[keep], final[keep], **final_style)
+        inset.set_xlim(lo, hi)
+        inset.tick_params(labelsize="x-small")
+        inset.set_title(f"{name}: {lo:.1f}-{hi:.1f} s", fontsize="x-small", pad=2)
+        ax[0].indicate_inset_zoom(inset, edgecolor="0.4")
+    ax[0].legend(loc="lower left", bbox_to_anchor=(0, 1.0), ncols=3, fontsize="small", frameon=False)
+    steady = t > end
+
+    def fitted(res: FitResult) -> np.ndarray:  # after the start-up, not held out
+        return steady & (res.weights[0] > 0) if res.weights else steady
+
+    limit = max(style.robust_limit(d.baseline.residuals[0], fitted(d.baseline)),
+                style.robust_limit(d.final.residuals[0], fitted(d.final)))
+    noise = d.baseline_evidence.noise_rms
+    for a, res, name in ((ax[1], d.baseline, "baseline"), (ax[2], d.final, "final")):
+        r = res.residuals[0]
+        a.axhspan(-noise, noise, color="#4393c3", alpha=0.2, lw=0, label=f"noise RMS +/-{noise:.3g} N")
+        a.plot(t, r, **style.RESIDUAL, label=f"{name} residual")
+        if res.weights:
+            for i, (lo, hi) in enumerate(_runs(t, res.weights[0] == 0)):
+                a.axvspan(lo, hi, color="#fee08b", alpha=0.35, lw=0, zorder=0,
+                          label="held out of the fit" if i == 0 else None)
+        style.mark_startup(a, t, np.abs(r), end, limit, "N")
+        rms = float(np.sqrt(np.mean(r[fitted(res)] ** 2)))
+        a.set(ylabel="residual [N]", ylim=(-limit, limit))
+        a.set_title(f"{name} ({_model_text(res)}): RMS residual {res.rms_residual:.3g} N "
+                    f"({rms:.3g} N on the fitted samples after the start-up)", fontsize="medium",
+                    loc="left")
+        a.legend(loc="upper right", fontsize="small", ncols=3)
+    ax[2].set_xlabel("time [s]")
+    fig.suptitle(f"Diagnosis of {d.baseline.problem.experiments[0].case.test.id}: before and after")
+    return fig
+
+
+def residual_spectra_figure(d: Diagnosis, path: str | Path | None = None):
+    """Amplitude spectra (N/sqrt(Hz)) of the measured force and of the baseline and final
+    residuals (the baseline thick and light under the thin final), the raw data's noise
+    floor, the drive frequency, the fitted mode frequencies of the final model and the
+    residual peaks the diagnosis found; returns the figure."""
+    t = np.asarray(d.baseline.problem.experiments[0].case.time, float)
+    fs = 1.0 / float(np.median(np.diff(t)))
+    drive = drive_frequency_of(d.baseline)
+    modes = mode_frequencies(d.final)
+    top_f = spectrum_top(fs, d.baseline.problem.force_cutoff_hz, [drive or 0.0, *modes.values()])
+    fig = style.figure(path, figsize=(10, 5))
+    ax = fig.subplots()
+    curves = []
+    for y, label, kw in ((d.baseline.measured[0], "measured (filtered)", {"color": "0.75", "lw": 1.0}),
+                         (d.baseline.residuals[0], f"baseline residual ({_model_text(d.baseline)})",
+                          {"color": "#e08214", "lw": 2.4, "alpha": 0.7}),
+                         (d.final.residuals[0], f"final residual ({_model_text(d.final)})",
+                          {"color": "0.1", "lw": 0.9})):
+        sp = welch_spectrum(t, y)
+        band = (sp.frequency <= top_f)
+        ax.semilogy(sp.frequency[band], np.sqrt(sp.psd[band]), label=label, **kw)
+        curves.append(np.sqrt(sp.psd[band & (sp.frequency > 0)]))
+    floor = noise_density(d.baseline, "force_x")
+    if floor is not None:
+        ax.axhline(floor, label="noise floor (raw data)", gid="noise floor", **style.NOISE)
+    if drive is not None and drive < top_f:
+        style.mark_frequency(ax, drive, f"drive {drive:.4g} Hz", style.DRIVE, gid="drive")
+    for k, f in modes.items():
+        if f < top_f:
+            style.mark_frequency(ax, f, f"{k} fitted {f:.4g} Hz", style.MODE, gid=f"mode {k}")
+    for i, p in enumerate(d.baseline_evidence.peaks):
+        ax.axvline(p.frequency, color="#b2182b", ls=":", lw=1.0, gid=f"peak {i + 1}",
+                   label="baseline residual peaks" if i == 0 else None)
+    cut = d.baseline.problem.force_cutoff_hz
+    if cut and cut < top_f:
+        ax.axvspan(cut, top_f, **style.DISCOUNT, label=f"above the {cut:g} Hz force filter")
+    ax.set(xlabel="frequency [Hz]", ylabel="amplitude density [N/sqrt(Hz)]", xlim=(0, top_f),
+           ylim=style.spectrum_limits(curves, floor))
+    ax.set_title("Residual spectra: what the baseline misses and the final model explains"
+                 + (" (drive: a sweep)" if drive is None else ""))
+    ax.legend(loc="upper right", fontsize="small", ncols=2)
+    return fig
+
+
+def _runs(t: np.ndarray, flag: np.ndarray) -> list[tuple[float, float]]:
+    """Time ranges (s) where ``flag`` holds."""
+    edges = np.flatnonzero(np.diff(np.r_[0, flag.astype(int), 0]))
+    return [(float(t[a]), float(t[b - 1])) for a, b in zip(edges[::2], edges[1::2])]

@@ -150,9 +150,10 @@ class _Fitter:
     counts the fits."""
 
     def __init__(self, cases: Sequence[Case], weights: Sequence[np.ndarray] | None,
-                 input_mode: str, cutoff: float | None) -> None:
+                 input_mode: str, cutoff: float | None, bar=None) -> None:
         self.cases, self.weights, self.count = list(cases), weights, 0
         self.input, self.cutoff = input_mode, cutoff
+        self.bar = bar  # a progress bar counting the fits, or None
 
     def problem(self, model: Model, measurement: Sequence[MeasurementModel], initial,
                 bounds=None, *, weights="default") -> FitProblem:
@@ -166,6 +167,8 @@ class _Fitter:
     def __call__(self, model: Model, measurement: Sequence[MeasurementModel], initial,
                  bounds=None, *, weights="default", warm: FitResult | None = None) -> FitResult:
         self.count += 1
+        if self.bar is not None:
+            self.bar.update()
         prob = self.problem(model, measurement, initial, bounds, weights=weights)
         # candidates that do not converge quickly are not what the data want; six-channel
         # spinning-rig fits have six times the residuals and start farther (no input)
@@ -236,7 +239,7 @@ def _input_mode(cases: Sequence[Case]) -> str:
 
 def diagnose(cases: Case | Sequence[Case], *, max_bic_change: float = MAX_BIC_CHANGE,
              max_rounds: int = 3, segments: int = 4,
-             force_cutoff_hz: float | None = None) -> Diagnosis:
+             force_cutoff_hz: float | None = None, progress: bool | None = None) -> Diagnosis:
     """Diagnose the baseline analog on ``cases`` and extend it greedily.
 
     Parameters
@@ -252,13 +255,24 @@ def diagnose(cases: Case | Sequence[Case], *, max_bic_change: float = MAX_BIC_CH
     force_cutoff_hz : float, optional
         Low-pass of the measured force when the input is filtered (spinning rig); default
         :func:`force_cutoff`.
+    progress : bool, optional
+        Show a bar counting the fits and naming the stage; default: on a terminal only.
     """
+    from .._progress import progress as bar
+
+    with bar(total=None, desc="diagnose", unit="fit", enabled=progress) as b:
+        return _diagnose(cases, max_bic_change, max_rounds, segments, force_cutoff_hz, b)
+
+
+def _diagnose(cases, max_bic_change: float, max_rounds: int, segments: int,
+              force_cutoff_hz: float | None, bar) -> Diagnosis:
     t0 = time.perf_counter()
     cases = [cases] if isinstance(cases, Case) else list(cases)
     mode = _input_mode(cases)
     model = baseline_model(cases[0])
     weights = [holdout_weights(c.time.size) for c in cases]
-    fitter = _Fitter(cases, weights, mode, force_cutoff_hz or force_cutoff(cases))
+    fitter = _Fitter(cases, weights, mode, force_cutoff_hz or force_cutoff(cases), bar)
+    bar.set_postfix_str("baseline")
     base = fitter(model, (), {})
     if not base.converged:
         # a lightly damped start next to a resonance can swing over the top: restart damped
@@ -278,7 +292,8 @@ def diagnose(cases: Case | Sequence[Case], *, max_bic_change: float = MAX_BIC_CH
     rounds: list[tuple[CandidateOutcome, ...]] = []
     lateral = all(c.test.rig == "lateral" for c in cases)
     measured = all(c.test.excitation == "measured" for c in cases)
-    for _ in range(max_rounds):
+    for i in range(max_rounds):
+        bar.set_postfix_str(f"round {i + 1}: candidates")
         outcomes = _round(fitter, current, evidence, predicted, cases[0].rig.gravity,
                           lateral=lateral, measured=measured, max_bic_change=max_bic_change)
         rounds.append(tuple(outcomes))
@@ -291,6 +306,7 @@ def diagnose(cases: Case | Sequence[Case], *, max_bic_change: float = MAX_BIC_CH
         evidence = collect_evidence(current, segments=segment_damping(current, n_segments=segments))
         fitter.count += segments
     start = {n: v for n, v in zip(current.names, current.values)}
+    bar.set_postfix_str("final fit")
     final = fitter(current.problem.model, current.problem.measurement, start,
                    _bounds_of(current), weights=None, warm=current)
     final_evidence = collect_evidence(final, segments=evidence.segments)

@@ -1,4 +1,5 @@
-"""Fit plots: measured vs simulated, residual, residual spectrum, parameter trajectories."""
+"""Fit plots: measured vs simulated with zooms, residual, residual spectrum, parameter
+trajectories."""
 
 from __future__ import annotations
 
@@ -7,66 +8,219 @@ from typing import TYPE_CHECKING
 
 import numpy as np
 
+from .. import _plotting as style
+
 if TYPE_CHECKING:  # pragma: no cover
     from .result import FitResult
 
-__all__ = ["plot_fit"]
+__all__ = ["plot_fit", "mode_frequencies", "drive_frequency_of", "noise_density", "spectrum_top"]
 
 
-def _pyplot():
-    import matplotlib
+def mode_frequencies(result: "FitResult") -> dict[str, float]:
+    """Fitted small-amplitude mode frequencies [Hz] by component (``p1``: 2.03)."""
+    return {k.removesuffix(".frequency_hz"): v for k, (v, _) in result.derived.items()
+            if k.endswith(".frequency_hz") and np.isfinite(v)}
 
-    if matplotlib.get_backend().lower() not in ("agg", "module://matplotlib_inline.backend_inline"):
-        matplotlib.use("Agg")
-    import matplotlib.pyplot as plt
 
-    return plt
+def drive_frequency_of(result: "FitResult", case: int = 0) -> float | None:
+    """The drive frequency of ``case`` [Hz]: the crank's, or the dominant frequency of the
+    carriage acceleration; None for a sweep or a record without a drive."""
+    from ..data.signals import drive_frequency
+
+    exp = result.problem.experiments[case]
+    if exp.case.crank is not None:
+        return float(exp.case.crank.frequency)
+    acc = result.drive_acceleration(case)
+    if acc is None:
+        return None
+    f, sweep = drive_frequency(exp.case.time, acc)
+    return None if sweep else f
+
+
+def noise_density(result: "FitResult", channel: str, case: int = 0) -> float | None:
+    """White-noise amplitude density of the raw ``channel`` [N/sqrt(Hz) or N m/sqrt(Hz)],
+    seen above the fitted band (1.5 times the force cutoff)."""
+    from ..data.signals import noise_level
+
+    exp = result.problem.experiments[case]
+    raw = exp.case.channels.get(channel)
+    if raw is None:
+        return None
+    t = np.asarray(exp.case.time, float)
+    fs = 1.0 / float(np.median(np.diff(t)))
+    cut = result.problem.force_cutoff_hz or 0.2 * fs
+    s = noise_level(t, raw, above_hz=1.5 * cut)
+    return float(s * np.sqrt(2.0 / fs)) if s > 0 else None
+
+
+def spectrum_top(fs: float, cutoff_hz: float | None, marked: list[float]) -> float:
+    """Upper frequency of a spectrum plot [Hz]: just past the force filter, or (unfiltered
+    data) four times the highest marked frequency, at least 15 Hz; at most Nyquist."""
+    top = 1.2 * cutoff_hz if cutoff_hz else max(15.0, 4.0 * max(marked, default=0.0))
+    return min(top, 0.5 * fs)
+
+
+def _zoom_windows(t: np.ndarray, end: float) -> tuple[tuple[float, float], tuple[float, float]]:
+    """A transient window (the start-up, where the response builds) and a steady one (the
+    record's end), each about 6 % of the record, at least 1 s and the start-up."""
+    span = max(1.0, 0.06 * (t[-1] - t[0]), end - t[0])
+    transient = (t[0], t[0] + span)
+    steady = (t[-1] - span, t[-1])
+    return transient, steady
+
+
+def _time_panel(ax, t, meas, sim, unit: str, name: str, *, zooms: bool) -> None:
+    ax.plot(t, meas, **style.MEASURED, label="measured (filtered)")
+    ax.plot(t, sim, **style.SIMULATED, label="simulated")
+    top = max(float(np.max(np.abs(meas))), float(np.max(np.abs(sim)))) or 1.0
+    ax.set(ylabel=f"{name} [{unit}]", xlim=(t[0], t[-1]))
+    if not zooms:
+        ax.set_ylim(-1.1 * top, 1.1 * top)
+        ax.legend(loc="lower left", bbox_to_anchor=(0, 1.0), ncols=2, fontsize="small", frameon=False)
+        return
+    # room above the trace for two zooms: the transient after the start-up and the steady end
+    ax.set_ylim(-1.1 * top, 2.9 * top)
+    ax.set_yticks([tk for tk in ax.get_yticks() if abs(tk) <= 1.1 * top])
+    end = style.startup_end(t)
+    boxes = ([0.04, 0.6, 0.42, 0.38], [0.54, 0.6, 0.42, 0.38])
+    for (lo, hi), bounds, title in zip(_zoom_windows(t, end), boxes, ("start-up", "steady")):
+        inset = ax.inset_axes(bounds)
+        keep = (t >= lo) & (t <= hi)
+        inset.plot(t[keep], meas[keep], **style.MEASURED)
+        inset.plot(t[keep], sim[keep], **style.SIMULATED)
+        inset.set_xlim(lo, hi)
+        inset.tick_params(labelsize="x-small")
+        inset.set_title(f"{title}: {lo:.1f}-{hi:.1f} s", fontsize="x-small", pad=2)
+        ax.indicate_inset_zoom(inset, edgecolor="0.4")
+    ax.legend(loc="lower left", bbox_to_anchor=(0, 1.0), ncols=2, fontsize="small", frameon=False)
+
+
+def _residual_panel(ax, t, items, unit: str, keep: np.ndarray | None) -> None:
+    """``items``: (name, residual). Symmetric axis from the residual after the start-up."""
+    end = style.startup_end(t)
+    steady = t > end
+    if keep is not None:
+        steady &= keep
+    limit = max(style.robust_limit(r, steady) for _, r in items)
+    for i, (name, r) in enumerate(items):
+        kw = dict(style.RESIDUAL) if len(items) == 1 else {"lw": 0.7, "color": f"C{i}"}
+        ax.plot(t, r, label=f"residual {name}" if len(items) > 1 else "residual (simulated - measured)",
+                **kw)
+    all_r = np.max(np.abs(np.vstack([r for _, r in items])), axis=0)
+    style.mark_startup(ax, t, all_r, end, limit, unit)
+    rms = [float(np.sqrt(np.mean(r[steady] ** 2))) for _, r in items]
+    ax.axhline(0.0, color="0.6", lw=0.5, zorder=1)
+    ax.set(ylabel=f"residual [{unit}]", xlabel="time [s]", ylim=(-limit, limit), xlim=(t[0], t[-1]))
+    ax.set_title(f"residual after the start-up: RMS {max(rms):.3g} {unit}", fontsize="medium", loc="left")
+    ax.legend(loc="upper right", fontsize="small", ncols=min(3, len(items) + 1))
+
+
+def _spectrum_panel(ax, result, case, t, items, unit: str, drive: float | None,
+                    modes: dict[str, float]) -> None:
+    """``items``: (name, measured, residual)."""
+    from ..data.signals import welch_spectrum
+
+    fs = 1.0 / float(np.median(np.diff(t)))
+    top_f = spectrum_top(fs, result.problem.force_cutoff_hz, [drive or 0.0, *modes.values()])
+    curves, floors = [], []
+    for i, (name, meas, res) in enumerate(items):
+        band_label = f" {name}" if len(items) > 1 else ""
+        sp = welch_spectrum(t, meas)
+        band = sp.frequency <= top_f
+        ax.semilogy(sp.frequency[band], np.sqrt(sp.psd[band]), label=f"measured{band_label}",
+                    **({**style.MEASURED, "lw": 1.8} if len(items) == 1 else {"lw": 1.6, "alpha": 0.35,
+                                                                               "color": f"C{i}"}))
+        curves.append(np.sqrt(sp.psd[band & (sp.frequency > 0)]))
+        sp = welch_spectrum(t, res)
+        ax.semilogy(sp.frequency[band], np.sqrt(sp.psd[band]), label=f"residual{band_label}",
+                    **(style.RESIDUAL if len(items) == 1 else {"lw": 0.8, "color": f"C{i}"}))
+        curves.append(np.sqrt(sp.psd[band & (sp.frequency > 0)]))
+        floor = noise_density(result, name, case)
+        if floor is not None:
+            floors.append(floor)
+    if floors:
+        floor = float(np.median(floors))
+        ax.axhline(floor, label="noise floor (raw data)", gid="noise floor", **style.NOISE)
+    else:
+        floor = None
+    if drive is not None and drive < top_f:
+        style.mark_frequency(ax, drive, f"drive {drive:.4g} Hz", style.DRIVE, gid="drive")
+    for k, f in modes.items():
+        if f < top_f:
+            style.mark_frequency(ax, f, f"{k} fitted {f:.4g} Hz", style.MODE, gid=f"mode {k}")
+    ax.set(xlabel="frequency [Hz]", ylabel=f"amplitude density [{unit}/sqrt(Hz)]", xlim=(0, top_f),
+           ylim=style.spectrum_limits(curves, floor))
+    if result.problem.force_cutoff_hz and result.problem.force_cutoff_hz < top_f:
+        ax.axvspan(result.problem.force_cutoff_hz, top_f, **style.DISCOUNT,
+                   label=f"above the {result.problem.force_cutoff_hz:g} Hz force filter")
+    ax.legend(loc="upper right", fontsize="small", ncols=2)
+
+
+def _trajectory_panel(ax, result) -> None:
+    from matplotlib.ticker import MaxNLocator, PercentFormatter
+
+    final = np.where(result.values == 0, 1.0, result.values)
+    change = 100.0 * (result.history / final - 1.0)
+    it = np.arange(change.shape[0])
+    for j, name in enumerate(result.names):
+        ax.plot(it, change[:, j], marker="o", ms=3, lw=1.0, color=f"C{j % 10}",
+                ls=("-", "--", ":", "-.")[j // 10 % 4], label=name)
+    ax.axhline(0.0, color="0.6", lw=0.5)
+    ax.xaxis.set_major_locator(MaxNLocator(integer=True))
+    ax.yaxis.set_major_formatter(PercentFormatter())
+    ax.set(xlabel="IPOPT iteration [-]", ylabel="change from the final estimate [%]",
+           xlim=(0, max(1, it[-1])))
+    ax.legend(loc="upper right", fontsize="small", ncols=min(4, len(result.names)))
 
 
 def plot_fit(result: "FitResult", path: str | Path | None = None, *, case: int = 0):
-    """Panels for ``case``: measured and simulated force (N) or, for multi-channel rigs,
-    every fitted channel (N, N m); the residual; residual and measured amplitude spectra
-    (Welch); and the estimates over IPOPT iterations (relative to their final values).
-    Saves to ``path`` when given; returns the figure."""
-    from ..data.signals import welch_spectrum
+    """The fit of ``case`` as a test engineer reads it.
 
-    plt = _pyplot()
+    Panels: measured (thick, light) and simulated (thin, dark, dashed) force or, for
+    multi-channel rigs, every fitted channel (N, N m), with zooms on the transient after the
+    start-up and on the steady end (lateral rig); the residual in N (and N m) on its own
+    symmetric axis, scaled by the residual after the start-up (the start-up is shaded and its
+    off-scale peak named); amplitude spectra of measured and residual in N/sqrt(Hz) up to
+    just past the force filter, with the raw data's noise floor, the drive frequency and the
+    fitted mode frequencies; and each estimate's change from its final value (%) over the
+    IPOPT iterations. Saves to ``path`` (PNG) when given; returns the figure (shown inline
+    in a notebook when ``path`` is None).
+
+    Examples
+    --------
+    >>> from estimate import FitProblem, fit, load_case, model_from_spec   # doctest: +SKIP
+    >>> case = load_case("A1.toml")                                        # doctest: +SKIP
+    >>> res = fit(FitProblem.build(case, model_from_spec("fixed,p1", case)))  # doctest: +SKIP
+    >>> plot_fit(res, "A1_fit.png")                                        # doctest: +SKIP
+    """
     exp = result.problem.experiments[case]
-    t = exp.case.time
+    t = np.asarray(exp.case.time, float)
     names = result.channels[case] if result.channels else ("force_x",)
     channels = [(n, *result.channel(n, case)) for n in names]  # (name, measured, residual)
-    rows = len(channels) + 3
-    fig, ax = plt.subplots(rows, 1, figsize=(9, 2.6 * rows + 1), constrained_layout=True)
+    groups: dict[str, list] = {}
+    for c in channels:
+        groups.setdefault(style.unit_of(c[0]), []).append(c)
+    single = len(channels) == 1
+    heights = [2.6 if single else 1.2] * len(channels) + [1.3] * len(groups) + [1.6] * len(groups) + [1.5]
+    fig = style.figure(path, figsize=(10, 1.9 * sum(heights) + 0.6))
+    ax = fig.subplots(len(heights), 1, height_ratios=heights)
+    keep = result.weights[case] > 0 if result.weights else None
     for a, (name, meas, res) in zip(ax, channels):
-        unit = "N m" if name.startswith("torque") else "N"
-        a.plot(t, meas, lw=0.8, label="measured (filtered)")
-        a.plot(t, meas + res, lw=0.8, label="simulated")
-        a.set(xlabel="time [s]", ylabel=f"{name} [{unit}]")
-        a.legend(loc="upper right", fontsize="small")
-    ax[0].set_title(f"{exp.case.test.id}: {' + '.join(result.problem.model.names)} "
-                    f"(RMS residual {result.rms_residual:.3g}, R^2 {result.r_squared:.5f})")
+        _time_panel(a, t, meas, meas + res, style.unit_of(name), name, zooms=single)
+    ax[len(channels) - 1].set_xlabel("time [s]")
     k = len(channels)
-    for name, _, res in channels:
-        ax[k].plot(t, res, lw=0.6, label=name)
-    ax[k].set(xlabel="time [s]", ylabel="residual [N, N m]")
-    if len(channels) > 1:
-        ax[k].legend(loc="upper right", fontsize="small")
-    for name, meas, res in channels[:1] if len(channels) == 1 else channels:
-        if len(channels) == 1:
-            sp = welch_spectrum(t, meas)
-            ax[k + 1].semilogy(sp.frequency, np.sqrt(sp.psd), label="measured")
-        sp = welch_spectrum(t, res)
-        label = f"residual {name}" if len(channels) > 1 else "residual"
-        ax[k + 1].semilogy(sp.frequency, np.sqrt(sp.psd), label=label)
-    ax[k + 1].set(xlabel="frequency [Hz]", ylabel="amplitude density [/sqrt(Hz)]", xlim=(0, 15))
-    ax[k + 1].legend(loc="upper right", fontsize="small")
+    for a, (unit, items) in zip(ax[k:], groups.items()):
+        _residual_panel(a, t, [(n, r) for n, _, r in items], unit, keep)
+    k += len(groups)
+    drive = drive_frequency_of(result, case)
+    modes = mode_frequencies(result)
+    for a, (unit, items) in zip(ax[k:], groups.items()):
+        _spectrum_panel(a, result, case, t, items, unit, drive, modes)
     if result.history.size:
-        final = np.where(result.values == 0, 1.0, result.values)
-        for j, name in enumerate(result.names):
-            ax[k + 2].plot(result.history[:, j] / final[j], label=name)
-        ax[k + 2].set(xlabel="IPOPT iteration", ylabel="estimate / final value", yscale="symlog")
-        ax[k + 2].legend(loc="best", fontsize="small")
-    if path is not None:
-        fig.savefig(path, dpi=110)
-        plt.close(fig)
+        _trajectory_panel(ax[-1], result)
+    else:
+        ax[-1].set_axis_off()
+    fig.suptitle(f"{exp.case.test.id}: {' + '.join(result.problem.model.names)} - RMS residual "
+                 f"{result.rms_residual:.3g} {'N' if single else '(scaled)'}, R^2 {result.r_squared:.5f}")
+    style.save(fig, path, dpi=110)
     return fig

@@ -147,6 +147,19 @@ class FitResult:
         j = names.index(name)
         return m[:, j], r[:, j]
 
+    def drive_acceleration(self, case: int = 0) -> np.ndarray | None:
+        """Carriage acceleration of ``case`` at its samples (m/s^2): the estimated carriage
+        motion when it was estimated, else the excitation's ``rig.x_ddot`` input; None for a
+        crank drive or a rig without a carriage input."""
+        if self.carriage and self.carriage[case] is not None:
+            return np.asarray(self.carriage[case])[2]
+        exp = self.problem.experiments[case]
+        dm = exp.derived
+        if dm.nu and "rig.x_ddot" in dm.inputs:
+            t = np.asarray(exp.case.time, float)
+            return np.asarray(exp.excitation.values(t))[dm.inputs.index("rig.x_ddot")]
+        return None
+
     @property
     def names(self) -> tuple[str, ...]:
         return self.problem.names

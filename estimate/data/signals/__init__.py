@@ -36,6 +36,7 @@ from .spectra import (
                       Spectrum,
                       check_drive_frequency,
                       dominant_frequency,
+                      drive_frequency,
                       find_spectral_peaks,
                       welch_spectrum,
 )
@@ -47,6 +48,7 @@ __all__ = [
     "check_drive_frequency",
     "displacement_derivatives",
     "dominant_frequency",
+    "drive_frequency",
     "find_spectral_peaks",
     "lowpass",
     "noise_level",

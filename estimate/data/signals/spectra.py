@@ -12,7 +12,7 @@ from analogs.errors import InputError
 
 from ._common import _MIN_SAMPLES, _as_uniform, _refine_frequency, _sine_design
 
-__all__ = ["DriveCheck", "Peak", "Spectrum", "check_drive_frequency", "dominant_frequency",
+__all__ = ["DriveCheck", "Peak", "Spectrum", "check_drive_frequency", "dominant_frequency", "drive_frequency",
            "find_spectral_peaks", "welch_spectrum"]
 
 
@@ -281,3 +281,29 @@ def check_drive_frequency(time: ArrayLike, force: ArrayLike, drive_frequency: fl
     return DriveCheck(passed=passed, drive_frequency=float(drive_frequency),
                       measured_frequency=measured, relative_error=err, tolerance=tolerance,
                       message=message)
+
+
+def drive_frequency(time: ArrayLike, acceleration: ArrayLike) -> tuple[float | None, bool]:
+    """Dominant frequency of a carriage acceleration [Hz], and whether the drive sweeps
+    (less than 70 % of the power within +/-10 % of the dominant frequency); ``(None, False)``
+    for a signal without power.
+
+    Examples
+    --------
+    >>> import numpy as np
+    >>> t = np.arange(3001) * 0.01
+    >>> f, sweep = drive_frequency(t, np.sin(2 * np.pi * 1.855 * t))
+    >>> round(f, 3), sweep
+    (1.855, False)
+    """
+    t = np.asarray(time, float)
+    acc = np.asarray(acceleration, float)
+    spec = welch_spectrum(t, acc)
+    p = spec.psd
+    if not np.any(p > 0):
+        return None, False
+    main = spec.frequency[int(np.argmax(p))]
+    near = np.abs(spec.frequency - main) <= 0.1 * main + 2 * spec.resolution
+    sweep = float(p[near].sum() / p.sum()) < 0.7
+    peaks = find_spectral_peaks(t, acc, min_frequency=0.5 * main, max_frequency=1.5 * main, max_peaks=1)
+    return (peaks[0].frequency if peaks else float(main)), sweep

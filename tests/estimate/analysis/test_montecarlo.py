@@ -160,7 +160,7 @@ def test_cli_montecarlo_local(tmp_path, capsys):
     data = json.loads((out / "montecarlo.json").read_text())
     assert data["samples"] == 12 and data["seed"] == 5
     assert len(data["envelopes"]["force_x"]["p50"]) == len(data["time"])
-    assert (out / "envelope.png").stat().st_size > 0
+    assert (out / "envelope.png").stat().st_size > 10_000
     assert "peak_force_x" in capsys.readouterr().out
     assert main(["montecarlo", str(fit), str(examples / "A1.toml"), "--samples", "12",
                  "--local", "--out", str(out)]) == 2  # exists, no --overwrite
@@ -220,3 +220,27 @@ def test_a_diaphragm_model_derives_the_same_quantities_in_monte_carlo_and_the_fi
     spread = mc.summary()["p1.frequency_hz"]["std"]
     assert spread > 0
     assert abs(mc.summary()["p1.frequency_hz"]["p50"] - f) < 5 * (se if math.isfinite(se) else spread)
+
+
+def test_envelope_plot_shows_the_deviation_from_the_nominal_with_the_measurement(fit):
+    """The bands are drawn as deviation from the nominal, on an axis sized by them and the
+    measured deviation (not the full force), with the measured trace under the nominal."""
+    from plot_checks import assert_distinguishable, assert_units, line
+
+    dm, t, exc, fixed = _problem()
+    res = monte_carlo(dm, t, exc, fit, 40, fixed=fixed, seed=3, batch_size=16)
+    nominal = res.nominal["force_x"]
+    values = {**{k: v for k, v in fit.values.items() if k in dm.parameter_names}, **fixed}
+    ref = simulate(dm, values, t, exc, integrator=RK4()).output("force_x")
+    assert np.max(np.abs(nominal - ref)) <= SAME_ARITHMETIC * np.max(np.abs(ref))
+    measured = ref + 0.01 * np.sin(7.0 * t)  # a "measurement" 0.01 N off the nominal
+    fig = res.plot(output="force_x", measured=measured)
+    top, dev = fig.axes
+    assert_units(top, x=False)
+    assert_units(dev)
+    assert dev.get_ylabel() == "force_x - nominal [N]"
+    assert_distinguishable(line(top, "measured"), line(top, "nominal"))
+    env = res.envelopes["force_x"]
+    band = max(np.max(np.abs(env[q] - nominal)) for q in (2.5, 97.5))
+    lo, hi = dev.get_ylim()
+    assert lo == -hi and band <= hi <= 1.5 * max(band, 0.01)  # sized by the bands, all shown

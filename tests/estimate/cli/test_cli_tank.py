@@ -35,7 +35,21 @@ def test_cli_volume_fill_legacy_and_plot(tmp_path):
     args = parse(["tank", "--radius", "0.1016", "--volume-fill", "0.648", "--method", "legacy",
                   "--plot", str(png)])
     assert args.run(args) == 0
-    assert png.stat().st_size > 1000
+    assert png.stat().st_size > 10_000
+    # what the plot shows: units, the requested fill marked, the legacy range shaded
+    from plot_checks import assert_units
+
+    pred = predict(Sphere(0.1016), volume_fill=0.648, method="legacy")
+    fig = _cli_tank._plot(args, Sphere(0.1016), pred.liquid, str(tmp_path / "again.png"), pred)
+    mass, freq, damping = fig.axes[:3]
+    for ax in (mass, freq, damping):
+        assert_units(ax, x=ax is damping)
+        assert [ln.get_xdata()[0] for ln in ax.get_lines() if ln.get_gid() == "requested fill"] \
+            == [pytest.approx(100 * pred.fill_fraction)]
+    legacy = [p for p in freq.patches if p.get_label() == "legacy basis not converged"]
+    assert legacy and legacy[0].get_x() == pytest.approx(50.0)
+    assert any("validity" in p.get_label() or "correlation" in p.get_label() for p in damping.patches)
+    assert mass.child_axes[0].get_xlabel() == "fill [% of tank volume]"
 
 
 def test_cli_bad_input_exits_2_with_message(capsys):

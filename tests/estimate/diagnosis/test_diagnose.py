@@ -7,6 +7,7 @@ variants and two more controls (each diagnosis takes 10-30 s on 2 cores)."""
 
 import math
 
+import numpy as np
 import pytest
 import reference_models as ref
 from synthetic_cases import G, make_case, pendulum
@@ -118,3 +119,43 @@ def test_hidden_effect_is_found_named_and_measured(name, tmp_path):
         assert f["cause"] in ("slosh_mode", "nonlinear_damping", "diaphragm_stiffness",
                               "sensor_delay", "rig_friction", "rotor")
         assert set(f) == {"cause", "evidence", "added", "rms_before", "rms_after", "gain", "bic_change"}
+    if name == "mode_a":
+        _check_report_figures(d, tmp_path / "report")
+
+
+def _check_report_figures(d, folder):
+    """fit_before_after.png: residuals on their own N axis, shared so the final one is
+    visibly smaller; residual_spectra.png: baseline under final, noise floor, the fitted
+    second mode marked where the baseline residual peaked."""
+    from plot_checks import assert_distinguishable, assert_units, assert_ylim_fits, line, marked
+
+    from estimate.diagnosis.report import before_after_figure, residual_spectra_figure, write_report
+
+    write_report(d, folder)
+    assert (folder / "fit_before_after.png").stat().st_size > 10_000
+    fig = before_after_figure(d, folder / "again.png")
+    force, base, final = fig.axes
+    for ax in fig.axes:
+        assert_units(ax, x=ax is final)
+    assert force.get_ylabel() == "force_x [N]"
+    assert base.get_ylabel() == final.get_ylabel() == "residual [N]"
+    assert_distinguishable(line(force, "measured"), line(force, "final"))
+    assert_distinguishable(line(force, "measured"), line(force, "baseline"))
+    assert len(force.child_axes) == 2
+    t, r = d.baseline.problem.experiments[0].case.time, d.baseline.residuals[0]
+    # the residual axis is a fraction of the force axis, set by the baseline residual
+    assert base.get_ylim()[1] < 0.5 * force.get_ylim()[1]
+    fitted = (t > t[0] + 2.0) & (d.baseline.weights[0] > 0)
+    assert_ylim_fits(base, r[fitted], 3.0)
+    assert final.get_ylim() == base.get_ylim()
+    fig = residual_spectra_figure(d, folder / "again.png")
+    ax = fig.axes[0]
+    assert_units(ax)
+    assert ax.get_ylabel() == "amplitude density [N/sqrt(Hz)]"
+    assert_distinguishable(line(ax, "baseline residual"), line(ax, "final residual"))
+    assert [ln for ln in ax.get_lines() if ln.get_gid() == "noise floor"]
+    assert marked(ax, "mode p2") == [pytest.approx(3.8, rel=0.03)]
+    assert marked(ax, "drive") == []  # a sweep has no single drive frequency
+    assert any(abs(f - 3.8) < 0.3 for f in marked(ax, "peak 1") + marked(ax, "peak 2"))
+    data = np.concatenate([ln.get_ydata() for ln in ax.get_lines()[:3]])
+    assert_ylim_fits(ax, data[data > 0], 1.5)

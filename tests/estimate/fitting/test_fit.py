@@ -42,7 +42,7 @@ def test_identifiable_parameters_recovered_within_two_percent(sine_case):
     assert len(fig.axes) == 4
     measured_line, simulated_line = fig.axes[0].get_lines()
     assert np.allclose(simulated_line.get_ydata(), res.simulated(0))
-    assert len(fig.axes[3].get_lines()) == len(res.names)
+    assert [ln.get_label() for ln in fig.axes[3].get_lines()][:len(res.names)] == list(res.names)
 
 
 def test_length_and_spring_confound_is_reported_with_the_frequency(sine_case):
@@ -166,3 +166,46 @@ def test_a_measured_and_a_crank_case_fit_together_in_either_order(order):
     assert [n for n in res.names if "omega_correction" in n] == ["A1_crank:rig.omega_correction"]
     for name in ("fixed.mass", "p1.mass", "p1.length"):
         assert res.value(name) == pytest.approx(truth[name], rel=0.01)
+
+
+def test_fit_plot_shows_what_it_is_for(tmp_path):
+    """The fit plot of the bundled example: measured under a thinner simulated line, zooms,
+    a residual axis in N scaled without the start-up, a spectrum in N/sqrt(Hz) with the
+    noise floor and the drive and fitted frequencies, relative trajectories over integer
+    iterations."""
+    from pathlib import Path
+
+    from plot_checks import assert_distinguishable, assert_units, assert_ylim_fits, line, marked
+
+    from estimate import load_case
+    from estimate.fitting.plots import plot_fit
+
+    case = load_case(Path(__file__).resolve().parents[3] / "examples" / "A1.toml")
+    res = fit(FitProblem.build(case, model_from_spec("fixed,p1:nospring", case)), progress=False)
+    fig = plot_fit(res, tmp_path / "fit.png")
+    assert (tmp_path / "fit.png").stat().st_size > 10_000
+    force, resid, spec, traj = fig.axes
+    for ax in (force, resid, spec, traj):
+        assert_units(ax, x=ax is not force)
+    assert force.get_ylabel() == "force_x [N]" and resid.get_ylabel() == "residual [N]"
+    assert spec.get_ylabel() == "amplitude density [N/sqrt(Hz)]"
+    meas, sim = line(force, "measured"), line(force, "simulated")
+    assert_distinguishable(meas, sim)
+    assert len(force.child_axes) == 2  # zooms: the start-up and the steady end
+    # the residual axis: set by the residual after the start-up, the start-up peak named
+    t, r = case.time, res.residuals[0]
+    steady = t > t[0] + 2.0
+    assert_ylim_fits(resid, r[steady], 3.0)
+    assert resid.get_ylim()[1] < np.max(np.abs(r))  # the start-up spike does not set the scale
+    # the spectrum: drive and fitted mode marked, noise floor drawn, data's range only
+    # crank at 1.855 Hz nominal plus d_omega = 0.04 rad/s (examples/A1_truth.json)
+    assert marked(spec, "drive") == [pytest.approx(1.855 + 0.04 / (2 * math.pi), rel=1e-3)]
+    assert marked(spec, "mode p1") == [pytest.approx(res.derived["p1.frequency_hz"][0])]
+    assert [ln for ln in spec.get_lines() if ln.get_gid() == "noise floor"]
+    densities = np.concatenate([ln.get_ydata() for ln in spec.get_lines()[:2]])
+    assert_ylim_fits(spec, densities[densities > 0], 1.5)
+    # trajectories: relative change (%) on a linear axis, integer iterations
+    assert traj.get_yscale() == "linear" and "[%]" in traj.get_ylabel()
+    ticks = [tk for tk in traj.get_xticks() if traj.get_xlim()[0] <= tk <= traj.get_xlim()[1]]
+    assert all(float(tk).is_integer() for tk in ticks)
+    assert all(ln.get_ydata()[-1] == pytest.approx(0.0, abs=1e-9) for ln in traj.get_lines()[:len(res.names)])

@@ -52,7 +52,7 @@ def test_six_channel_fit_recovers_rotor_and_pendulum(spinning_case):
     from estimate.fitting.plots import plot_fit
 
     fig = plot_fit(res)
-    assert len(fig.axes) == 6 + 3
+    assert len(fig.axes) == 6 + 2 + 2 + 1  # channels; residual and spectrum in N and N m; iterations
     measured_line, simulated_line = fig.axes[4].get_lines()
     assert np.allclose(measured_line.get_ydata(), meas)
     assert np.allclose(simulated_line.get_ydata(), meas + resid)
