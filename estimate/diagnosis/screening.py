@@ -20,8 +20,8 @@ from dataclasses import dataclass, field
 from analogs import Component, CubicHingeSpring, HingeFriction, HingeTorqueTerms, Model, QuadraticDamper
 from analogs.hinge_nonlinear import TORQUE_TERMS
 
+from ..fitting.linearise import linearise
 from ..fitting.measurement import MeasurementModel, RigFriction, SensorOffset
-from ..fitting.nlp import linearise
 from ..fitting.problem import FitProblem
 from ..fitting.result import FitResult
 

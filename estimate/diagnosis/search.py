@@ -38,6 +38,7 @@ from .candidates import Proposal, propose
 from .evidence import Evidence, collect_evidence, segment_damping
 from .families import family_proposal
 from .outcome import CandidateOutcome, Diagnosis, Finding, Verdict
+from .scoring import bic, heldout, holdout_weights, poor_start
 from .screening import families, screen
 
 __all__ = ["Diagnosis", "Finding", "CandidateOutcome", "diagnose", "baseline_model"]
@@ -75,66 +76,6 @@ def baseline_model(case: Case) -> Model:
     return (LateralRig(excitation=case.test.excitation) + FixedMass("fixed") + Pendulum("p1")
             + HingeDamper("p1"))
 
-
-def holdout_weights(n: int, *, blocks: int = 10, held: Sequence[int] = (1, 4, 7)) -> np.ndarray:
-    """Weights leaving out interleaved blocks (default 3 of 10) of an ``n``-sample record."""
-    w = np.ones(n)
-    edges = np.linspace(0, n, blocks + 1).astype(int)
-    for b in held:
-        w[edges[b]:edges[b + 1]] = 0.0
-    return w
-
-
-def _heldout(res: FitResult) -> tuple[float, float]:
-    """Held-out RMS residual (N, or channel scales) and held-out chi-square.
-
-    With an estimated input, the carriage motion in held-out blocks rests on the
-    displacement alone, whose noise makes acceleration noise above the signal band: the
-    held-out residuals are low-passed to the band of the mechanics (where the noise levels
-    were read from, :attr:`RecordNoise.band_hz`) before they are compared, and the
-    chi-square counts one independent sample per ``fs / (2 band)`` samples."""
-    from ..data.signals import lowpass
-
-    num = chi2 = 0.0
-    cnt = 0
-    for i, w in enumerate(res.weights):
-        out = w == 0
-        if not np.any(out):
-            continue
-        chans = res.channels[i] if res.channels else ("force_x",)
-        report = np.array([res.channel_scales[i][c] for c in chans]) if res.channel_scales \
-            else np.ones(len(chans))
-        cost = np.array([res.problem.channel_scales(i)[c] for c in chans])
-        r = res.residuals[i] if res.residuals[i].ndim == 2 else res.residuals[i][:, None]
-        noise = res.problem.noise[i] if res.problem.noise else None
-        factor = 1.0
-        if noise is not None:
-            t = res.problem.experiments[i].case.time
-            fs = 1.0 / float(np.median(np.diff(t)))
-            if noise.band_hz < 0.45 * fs:
-                r = np.column_stack([lowpass(t, r[:, j], cutoff_hz=noise.band_hz)
-                                     for j in range(r.shape[1])])
-                factor = min(2 * noise.band_hz / fs, 1.0)
-                cost = cost * np.sqrt(factor)
-        r = r[out]
-        num += float(np.sum((r / report) ** 2))
-        chi2 += float(np.sum((r / cost) ** 2)) * factor
-        cnt += r.size
-    return (math.sqrt(num / cnt), chi2) if cnt else (res.rms_residual, math.nan)
-
-
-def _weighted(res: FitResult) -> bool:
-    return bool(res.problem.noise) and any(n is not None for n in res.problem.noise)
-
-
-def _bic(res: FitResult, extra_params: int = 0) -> float:
-    """Bayesian information criterion (up to a constant): the objective when the residuals
-    are in units of their noise, else ``n log(cost / n)``."""
-    n = res.n_samples
-    k = len(res.names) + extra_params
-    if _weighted(res):
-        return res.objective + k * math.log(n)
-    return n * math.log(res.cost / n) + k * math.log(n)
 
 
 # candidates start at the current fit and the step their score points to: a good one
@@ -320,9 +261,9 @@ def _round(fitter: _Fitter, current: FitResult, evidence: Evidence, predicted, g
            *, lateral: bool, measured: bool, max_bic_change: float) -> list[CandidateOutcome]:
     """One round: screen, fit the promising candidates, score them; best first."""
     measurement = tuple(current.problem.measurement)
-    rms0, chi0 = _heldout(current)
+    rms0, chi0 = heldout(current)
     delays = sum(isinstance(m, SensorDelay) for m in measurement)
-    bic0 = _bic(current, delays)
+    bic0 = bic(current, delays)
     outcomes: list[CandidateOutcome] = []
     proposals: list[tuple[Proposal, float]] = []
     single = all(len(e.channels) == 1 for e in current.problem.experiments)
@@ -377,21 +318,6 @@ def _round(fitter: _Fitter, current: FitResult, evidence: Evidence, predicted, g
     return outcomes
 
 
-#: Residual variance (in units of the noise variance) above which the current fit is a
-#: poor place to start a candidate: its residual is more than twice the noise.
-POOR_START_VARIANCE = 4.0
-
-
-def _poor_start(current: FitResult, res: FitResult) -> bool:
-    """The current estimates are far from the data and the candidate started from them did
-    not reach the noise (residual variances in units of the noise variance)."""
-    from .evidence import NOISE_MARGIN
-
-    v0, v1 = current.residual_variance, res.residual_variance
-    return (math.isfinite(v0) and v0 > POOR_START_VARIANCE
-            and (not res.converged or not v1 <= NOISE_MARGIN**2))
-
-
 def _not_fitted(sc, current: FitResult, rms0: float, why: str) -> CandidateOutcome:
     return CandidateOutcome(sc.family.cause, (sc.family.label,), rms0, math.nan, -math.inf,
                             math.inf, why, "", current, score=sc.statistic)
@@ -408,7 +334,7 @@ def _try(fitter: _Fitter, prop: Proposal, current: FitResult, score: float, rms0
         else:
             res = fitter(prop.model, prop.measurement, start, prop.bounds, warm=current)
             extra = 0
-            if _poor_start(current, res) and prop.cold_start is not None:
+            if poor_start(current, res) and prop.cold_start is not None:
                 # a strong effect the current model cannot carry bends its estimates
                 # into another basin (a hardening hinge made a 13 kg fixed mass): start
                 # again from the prediction, with the effect read off the amplitude trend
@@ -419,10 +345,10 @@ def _try(fitter: _Fitter, prop: Proposal, current: FitResult, score: float, rms0
     except (ValueError, RuntimeError) as err:
         return CandidateOutcome(prop.cause, prop.added, rms0, math.nan, -math.inf, math.inf,
                                 f"fit failed: {err}", "", current, score=score)
-    rms1, chi1 = _heldout(res)
+    rms1, chi1 = heldout(res)
     gain = 1 - rms1 / rms0
     dchi = chi0 - chi1
-    dbic = _bic(res, extra + delays) - bic0
+    dbic = bic(res, extra + delays) - bic0
     if not res.converged:
         reason = f"the fit did not converge ({res.status})"
     elif not dchi >= MIN_HELDOUT_CHI2:
