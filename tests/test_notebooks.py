@@ -6,6 +6,7 @@ Refresh the saved outputs with ``python tests/test_notebooks.py`` (executes ever
 in place)."""
 
 import math
+import os
 import re
 import sys
 from pathlib import Path
@@ -37,7 +38,14 @@ def execute(path):
     nb = nbformat.read(path, as_version=4)
     client = nbclient.NotebookClient(nb, timeout=600, kernel_name="python3",
                                      resources={"metadata": {"path": str(path.parent)}})
-    client.execute()
+    # the kernel inherits the environment: a non-interactive MPLBACKEND (Agg, set for
+    # scripts and CI) would stop the inline backend from showing the figures
+    backend = os.environ.pop("MPLBACKEND", None)
+    try:
+        client.execute()
+    finally:
+        if backend is not None:
+            os.environ["MPLBACKEND"] = backend
     return nb
 
 
