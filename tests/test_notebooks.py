@@ -56,9 +56,14 @@ def _text(output) -> str:
 
 
 def _cell_outputs(cell):
-    """(kinds, text) of a code cell's outputs; temporary paths and object ids masked."""
-    kinds = [("image" if "image/png" in o.get("data", {}) else o.get("output_type"))
-             for o in cell.get("outputs", [])]
+    """(kinds, text) of a code cell's outputs; temporary paths and object ids masked.
+    Consecutive stream outputs count as one: how the kernel splits printed text into
+    stream messages depends on timing, not on what the cell printed."""
+    kinds = []
+    for o in cell.get("outputs", []):
+        kind = "image" if "image/png" in o.get("data", {}) else o.get("output_type")
+        if not (kind == "stream" and kinds and kinds[-1] == "stream"):
+            kinds.append(kind)
     text = "".join(_text(o) for o in cell.get("outputs", []))
     text = re.sub(r"/tmp/\S+", "<tmp>", text)
     text = re.sub(r"0x[0-9a-f]+", "<id>", text)
