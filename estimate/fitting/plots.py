@@ -69,8 +69,10 @@ def _zoom_windows(t: np.ndarray, end: float) -> tuple[tuple[float, float], tuple
     return transient, steady
 
 
-def _time_panel(ax, t, meas, sim, unit: str, name: str, *, zooms: bool) -> None:
-    ax.plot(t, meas, **style.MEASURED, label="measured (filtered)")
+def _time_panel(ax, t, meas, sim, unit: str, name: str, *, zooms: bool,
+                filtered: bool = True) -> None:
+    # with an estimated carriage motion the force is fitted raw (motor tones removed)
+    ax.plot(t, meas, **style.MEASURED, label="measured (filtered)" if filtered else "measured")
     ax.plot(t, sim, **style.SIMULATED, label="simulated")
     top = max(float(np.max(np.abs(meas))), float(np.max(np.abs(sim)))) or 1.0
     ax.set(ylabel=f"{name} [{unit}]", xlim=(t[0], t[-1]))
@@ -205,8 +207,10 @@ def plot_fit(result: "FitResult", path: str | Path | None = None, *, case: int =
     fig = style.figure(path, figsize=(10, 1.9 * sum(heights) + 0.6))
     ax = fig.subplots(len(heights), 1, height_ratios=heights)
     keep = result.weights[case] > 0 if result.weights else None
+    estimated = bool(result.problem.carriage) and result.problem.carriage[case] is not None
     for a, (name, meas, res) in zip(ax, channels):
-        _time_panel(a, t, meas, meas + res, style.unit_of(name), name, zooms=single)
+        _time_panel(a, t, meas, meas + res, style.unit_of(name), name, zooms=single,
+                    filtered=not estimated)
     ax[len(channels) - 1].set_xlabel("time [s]")
     k = len(channels)
     for a, (unit, items) in zip(ax[k:], groups.items()):
