@@ -119,7 +119,10 @@ def test_an_interrupted_diagnosis_writes_nothing_and_keeps_the_previous_report(t
         if proc.poll() is None:
             proc.kill()
     assert proc.returncode == 130, err.decode()
-    assert b"slosh diagnose: interrupted by SIGINT: nothing was written" in err
+    # inside native code that takes seconds (CasADi compiling a candidate's C code under a
+    # loaded CI) the watchdog ends it instead: the same guarantees, another sentence
+    assert (b"slosh diagnose: interrupted by SIGINT: nothing was written" in err
+            or b"slosh diagnose: interrupted by SIGINT; it did not stop within" in err), err
     assert out.read_bytes() == KEEP
     assert [p.name for p in report.iterdir()] == ["summary.md"]
     assert (report / "summary.md").read_bytes() == KEEP
