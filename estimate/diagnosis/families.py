@@ -4,6 +4,8 @@ points the same way)."""
 
 from __future__ import annotations
 
+import math
+
 from ..fitting.result import FitResult
 from .candidates import Proposal
 from .evidence import Evidence
@@ -36,8 +38,6 @@ def evidence_start(cause: str, host: str, evidence: Evidence, inertia: float
     * dry friction: a torque ``Tc sign(thd)`` dissipates like a damping ratio
       ``2 Tc / (pi I w^2 a)``, so ``Tc = pi I w^2 (z(a0) - z(a1)) / (2 (1/a0 - 1/a1))``.
     """
-    import math
-
     if cause == "nonlinear_stiffness":
         tr = evidence.frequency_trend
         if tr is None or tr.t < 2:

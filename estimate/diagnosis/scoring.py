@@ -9,6 +9,7 @@ from collections.abc import Sequence
 import numpy as np
 
 from ..fitting.result import FitResult
+from .evidence import NOISE_MARGIN
 
 __all__ = ["holdout_weights", "heldout", "bic", "poor_start", "POOR_START_VARIANCE"]
 
@@ -82,8 +83,6 @@ POOR_START_VARIANCE = 4.0
 def poor_start(current: FitResult, res: FitResult) -> bool:
     """The current estimates are far from the data and the candidate started from them did
     not reach the noise (residual variances in units of the noise variance)."""
-    from .evidence import NOISE_MARGIN
-
     v0, v1 = current.residual_variance, res.residual_variance
     return (math.isfinite(v0) and v0 > POOR_START_VARIANCE
             and (not res.converged or not v1 <= NOISE_MARGIN**2))

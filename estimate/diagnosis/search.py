@@ -113,16 +113,15 @@ class _Fitter:
         prob = self.problem(model, measurement, initial, bounds, weights=weights)
         # candidates that do not converge quickly are not what the data want; six-channel
         # spinning-rig fits have six times the residuals and start farther (no input)
-        same_states = warm is not None and all(
-            a.derived.coordinates == b.derived.coordinates
-            for a, b in zip(prob.experiments, warm.problem.experiments))
         if not all(len(e.channels) == 1 for e in prob.experiments):
             opts = _SPINNING_SOLVER
+        elif warm is None:  # the baseline and starts from the prediction
+            opts = {}
+        elif all(a.derived.coordinates == b.derived.coordinates
+                 for a, b in zip(prob.experiments, warm.problem.experiments)):
+            opts = _CANDIDATE_SOLVER  # warm on the same states: a good one is quick
         else:
-            # warm-started on the same states, a good candidate converges within 40
-            # iterations; new states (another mode) start from a simulation
-            opts = {} if warm is None else _CANDIDATE_SOLVER if same_states \
-                else _NEW_STATES_SOLVER
+            opts = _NEW_STATES_SOLVER  # new states (another mode) start from a simulation
         return fit(prob, progress=False, solver_options=opts, warm_start=warm)
 
 
