@@ -230,7 +230,11 @@ class _Nlp:
 
     @cached_property
     def jac_r(self) -> ca.MX:
-        return ca.jacobian(self.r, self.w)
+        """``d r / d w``: assembled from the cases' blocks when each has them."""
+        if not all(t.jacobian is not None for t in self.terms):
+            return ca.jacobian(self.r, self.w)
+        return ca.horzcat(ca.vertcat(*[t.jacobian[0] for t in self.terms]),
+                          ca.diagcat(*[t.jacobian[1] for t in self.terms]))
 
     @cached_property
     def e(self) -> ca.MX:

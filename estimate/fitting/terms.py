@@ -17,6 +17,7 @@ from derive import OUTPUT_NAMES, RK4, Sampled, simulate
 from ..data.signals import lowpass
 from ._sparse import sparse_dm
 from .problem import FitProblem
+from .residual_jacobian import force_residual_jacobian
 from .steady import steady_start
 from .transcription import Block, InputCoefficients, Transcription
 
@@ -82,7 +83,9 @@ class CaseTerms:
     the cost residual and ``e`` the residual whose squares the covariance uses (``= r`` for
     the squared cost): force residuals divided by their scale, then displacement residuals
     divided by the displacement noise. ``raw`` is ``Y - F`` (N, N m; channel-major) and
-    ``report`` the force residual in the units of the fit report (weighted, scaled)."""
+    ``report`` the force residual in the units of the fit report (weighted, scaled).
+    ``jacobian``, when assembled, is ``(d r / d theta, d r / d (block.w, coef))``
+    (:mod:`estimate.fitting.residual_jacobian`); ``None``: CasADi differentiates ``r``."""
 
     block: Block
     coef: ca.MX
@@ -97,6 +100,7 @@ class CaseTerms:
     free_initial_state: bool
     carriage: ca.MX | None
     displacement_residual: ca.MX | None
+    jacobian: tuple[ca.MX, ca.MX] | None = None
 
 
 def case_terms(problem: FitProblem, i: int, theta_s: ca.MX, transcription: Transcription,
@@ -117,10 +121,10 @@ def case_terms(problem: FitProblem, i: int, theta_s: ca.MX, transcription: Trans
         c = ca.MX.sym(f"carriage{i}", carriage.n_coefficients)
         fr = transcription.fractions()
         stage_times = (t[:-1, None] + np.diff(t)[:, None] * fr[None, :]).ravel()
-        A_stage = carriage.inputs_matrix(stage_times)
-        U = ca.reshape(ca.mtimes(sparse_dm(A_stage), c), dm.nu * fr.size, n - 1)
-        A_grid = carriage.inputs_matrix(t)
-        Ug = ca.reshape(ca.mtimes(sparse_dm(A_grid), c), dm.nu, n)
+        A_stage = sparse_dm(carriage.inputs_matrix(stage_times))
+        U = ca.reshape(ca.mtimes(A_stage, c), dm.nu * fr.size, n - 1)
+        A_grid = sparse_dm(carriage.inputs_matrix(t))
+        Ug = ca.reshape(ca.mtimes(A_grid, c), dm.nu, n)
         coefficients = InputCoefficients(c, A_stage)
         coef0 = carriage.coefficients
         if warm is not None and warm.carriage is not None and warm.carriage.size == coef0.size:
@@ -150,10 +154,10 @@ def case_terms(problem: FitProblem, i: int, theta_s: ca.MX, transcription: Trans
     Y = _measured_output(dm, chans).map(n)(block.X, Ug, p_i, ca.DM(t).T).T
     mvals = {e.parameter: theta_s[j] * e.scale for j, e in enumerate(problem.estimated)
              if e.case in (None, i)}
-    for mm in problem.measurement:
-        extra = mm.term(Ug, dm.inputs, mvals, t)
-        if extra is not None:
-            Y = Y + extra
+    extras = [x for x in (mm.term(Ug, dm.inputs, mvals, t) for mm in problem.measurement)
+              if x is not None]
+    for extra in extras:
+        Y = Y + extra
     F, wts = _measured_force(problem, i)
     scale = problem.channel_scales(i)
     s = np.array([scale[ch] for ch in chans])
@@ -183,9 +187,30 @@ def case_terms(problem: FitProblem, i: int, theta_s: ca.MX, transcription: Trans
         ex = x_resid / carriage.displacement_noise
         e = ca.vertcat(e, ex)
         r = e if cost == "squared" else ca.vertcat(r, ex)
+    jac = None
+    if cost == "squared" and blocks_ok and block.jac_w is not None and dm.nx:
+        factor = wv / np.repeat(s, n)
+        jt, jx, jc = force_residual_jacobian(
+            dm, chans, block.X, Ug, p_i, theta_s, t, factor, initial_state == "rest",
+            compile_, None if carriage is None else A_grid)
+        if extras:
+            ye = sum(extras[1:], extras[0])
+            if ye.shape != Y.shape:  # a term of one column added to every channel
+                ye = ca.repmat(ye, 1, len(chans)) if ye.size2() == 1 else ca.repmat(ye, n, 1)
+            ye = ca.vec(ye) * ca.DM(factor)
+            jt = jt + ca.jacobian(ye, theta_s)
+            if carriage is not None:
+                jc = jc + ca.jacobian(ye, coef)
+        jlocal = ca.horzcat(jx, jc if jc is not None else ca.MX(jx.size1(), 0))
+        if carriage is not None:
+            nd = carriage.displacement.size
+            jt = ca.vertcat(jt, ca.MX(nd, jt.size2()))
+            jlocal = ca.vertcat(jlocal, ca.horzcat(ca.MX(nd, jx.size2()),
+                                                   B0 / carriage.displacement_noise))
+        jac = (jt, jlocal)
     return CaseTerms(block, coef, coef0, r, e, raw, report, F, wts,
                      scaled_measured, initial_state == "free" and dm.nx > 0,
-                     None if carriage is None else ca.reshape(Ug, dm.nu, n), x_resid)
+                     None if carriage is None else ca.reshape(Ug, dm.nu, n), x_resid, jac)
 
 
 @dataclass(frozen=True)

@@ -18,12 +18,9 @@ from dataclasses import dataclass
 
 import casadi as ca
 import numpy as np
-import scipy.sparse as sps
 
 from derive import DerivedModel, Excitation, rk4_step
 from derive.simulate import interval_inputs
-
-from ._sparse import sparse_dm
 
 __all__ = ["Transcription", "MultipleShooting", "Collocation", "Block", "InputCoefficients"]
 
@@ -52,10 +49,11 @@ class Block:
 @dataclass(frozen=True)
 class InputCoefficients:
     """Stage inputs that are a linear function of decision variables: ``vec(U) = A c``
-    (``A`` sparse, rows in the order of ``vec`` of the ``(nu m, n - 1)`` stage inputs)."""
+    (``A`` a sparse CasADi matrix, rows in the order of ``vec`` of the ``(nu m, n - 1)``
+    stage inputs)."""
 
     c: ca.MX
-    A: sps.spmatrix
+    A: ca.DM
 
 
 class Transcription:
@@ -121,7 +119,7 @@ class MultipleShooting(Transcription):
         if coefficients is not None:
             # d g_k / d c = -(d Phi_k / d U_k) A_k: block-diagonal stage Jacobians times A
             nU = int(U.size1())
-            jac_c = ca.mtimes(_block_diagonal(dm.nx, nU, n - 1, -JuT), sparse_dm(coefficients.A))
+            jac_c = ca.mtimes(_block_diagonal(dm.nx, nU, n - 1, -JuT), coefficients.A)
         return Block(ca.vec(W), np.asarray(w0).ravel(order="F"), g, X, jac_theta, jac_w,
                      ca.vec(X[:, 1:] - xn), jac_c)
 
