@@ -50,18 +50,45 @@ def _source_digest(cls: type) -> str:
     for klass in cls.__mro__:
         if klass is object:
             continue
-        try:
-            h.update(inspect.getsource(klass).encode())
-        except (OSError, TypeError):
-            raise SourceUnavailable(klass, "the class") from None
-        module = sys.modules.get(klass.__module__)
-        try:
-            h.update(inspect.getsource(module).encode())  # type: ignore[arg-type]
-        except (OSError, TypeError):
-            raise SourceUnavailable(klass, "the module") from None
+        text, classes = _module_source(sys.modules.get(klass.__module__), klass)
+        if klass.__qualname__ not in classes:
+            raise SourceUnavailable(klass, "the class")
+        h.update(klass.__qualname__.encode())
+        h.update(text.encode())  # holds the class's own source
         if klass is Component:
             break
     return h.hexdigest()[:16]
+
+
+def _module_source(module, klass: type) -> tuple[str, frozenset[str]]:
+    """The source of ``module`` and the qualified names of the classes it defines (parsed
+    once per source text: reading each class with ``inspect.getsource`` parses the module
+    again for every class)."""
+    try:
+        text = inspect.getsource(module)  # type: ignore[arg-type]
+    except (OSError, TypeError):
+        raise SourceUnavailable(klass, "the module") from None
+    if text not in _CLASSES:
+        import ast
+
+        names: set[str] = set()
+
+        def visit(node, prefix: str) -> None:
+            for child in ast.iter_child_nodes(node):
+                if isinstance(child, ast.ClassDef):
+                    names.add(prefix + child.name)
+                    visit(child, f"{prefix}{child.name}.")
+                elif isinstance(child, (ast.FunctionDef, ast.AsyncFunctionDef)):
+                    visit(child, f"{prefix}{child.name}.<locals>.")
+                else:
+                    visit(child, prefix)
+
+        visit(ast.parse(text), "")
+        _CLASSES[text] = frozenset(names)
+    return text, _CLASSES[text]
+
+
+_CLASSES: dict[str, frozenset[str]] = {}
 
 
 class Component:
