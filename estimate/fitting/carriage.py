@@ -19,6 +19,7 @@ acceleration at the first sample).
 
 from __future__ import annotations
 
+import hashlib
 from dataclasses import dataclass, field
 
 import numpy as np
@@ -126,6 +127,7 @@ class CarriageInput:
     displacement: np.ndarray = field(repr=False)
     displacement_tones: tuple[tuple[float, float], ...]
     at_rest: bool
+    _memo: dict = field(default_factory=dict, compare=False, repr=False)
 
     @property
     def n_coefficients(self) -> int:
@@ -141,6 +143,23 @@ class CarriageInput:
         :meth:`CarriageSpline.inputs_matrix`)."""
         A = self.spline.inputs_matrix(times)
         return A if self.basis is None else (A @ self.basis).tocsr()
+
+    def casadi_matrices(self, times: np.ndarray, fractions: np.ndarray):
+        """``(A_stage, A_grid, B0)`` as sparse CasADi matrices: :meth:`inputs_matrix` at
+        the stage times ``times[k] + fractions * (times[k+1] - times[k])`` and at ``times``,
+        and :meth:`design` at ``times``. Kept with this object: every fit of the record
+        (the diagnosis fits many models to it) reuses them."""
+        t = np.asarray(times, float)
+        fr = np.asarray(fractions, float)
+        key = (t.tobytes(), fr.tobytes())
+        if key not in self._memo:
+            from ._sparse import sparse_dm
+
+            stage_times = (t[:-1, None] + np.diff(t)[:, None] * fr[None, :]).ravel()
+            self._memo.clear()  # one grid at a time: these are large
+            self._memo[key] = (sparse_dm(self.inputs_matrix(stage_times)),
+                               sparse_dm(self.inputs_matrix(t)), sparse_dm(self.design(t)))
+        return self._memo[key]
 
     def values(self, coefficients: np.ndarray, times: np.ndarray) -> np.ndarray:
         """``(3, len(times))``: displacement (m), velocity (m/s), acceleration (m/s^2)."""
@@ -195,7 +214,34 @@ def carriage_input(time: np.ndarray, displacement: np.ndarray, *,
                    force: np.ndarray | None = None) -> tuple[CarriageInput, RecordNoise]:
     """Spline, start values and noise levels for estimating the carriage motion of a record
     (``time`` s, ``displacement`` m, ``force`` N), and the force's noise. ``at_rest=None``
-    detects a quiet start (:func:`estimate.data.signals.starts_quiet` on both channels)."""
+    detects a quiet start (:func:`estimate.data.signals.starts_quiet` on both channels).
+
+    The last few records' results are kept (keyed by the samples' bytes): the diagnosis
+    builds a problem per candidate model of the same record. The returned objects are
+    shared; treat them as read-only."""
+    arrays = [None if a is None else np.ascontiguousarray(a, float)
+              for a in (time, displacement, force)]
+    key = (hashlib.sha256(b"".join(b"" if a is None else a.tobytes() for a in arrays)).hexdigest(),
+           tuple(-1 if a is None else a.size for a in arrays), at_rest)
+    if key not in _RECENT:
+        _RECENT[key] = _carriage_input(arrays[0], arrays[1], arrays[2], at_rest=at_rest)
+        while len(_RECENT) > _RECENT_SIZE:
+            _RECENT.pop(next(iter(_RECENT)))
+    return _RECENT[key]
+
+
+_RECENT: dict = {}
+_RECENT_SIZE = 4
+
+
+def forget_records() -> None:
+    """Drop the kept :func:`carriage_input` results (benchmarks time a first fit of a
+    record with it)."""
+    _RECENT.clear()
+
+
+def _carriage_input(time: np.ndarray, displacement: np.ndarray, force: np.ndarray, *,
+                    at_rest: bool | None) -> tuple[CarriageInput, RecordNoise]:
     t = np.asarray(time, float)
     x = np.asarray(displacement, float)
     dt = float(np.median(np.diff(t)))

@@ -15,7 +15,6 @@ from analogs.errors import InputError
 from derive import OUTPUT_NAMES, RK4, Sampled, simulate
 
 from ..data.signals import lowpass
-from ._sparse import sparse_dm
 from .problem import FitProblem
 from .residual_jacobian import force_residual_jacobian
 from .steady import steady_start
@@ -120,10 +119,8 @@ def case_terms(problem: FitProblem, i: int, theta_s: ca.MX, transcription: Trans
                              f"{', '.join(_CARRIAGE_INPUTS)}; the model takes {', '.join(dm.inputs)}")
         c = ca.MX.sym(f"carriage{i}", carriage.n_coefficients)
         fr = transcription.fractions()
-        stage_times = (t[:-1, None] + np.diff(t)[:, None] * fr[None, :]).ravel()
-        A_stage = sparse_dm(carriage.inputs_matrix(stage_times))
+        A_stage, A_grid, B0 = carriage.casadi_matrices(t, fr)
         U = ca.reshape(ca.mtimes(A_stage, c), dm.nu * fr.size, n - 1)
-        A_grid = sparse_dm(carriage.inputs_matrix(t))
         Ug = ca.reshape(ca.mtimes(A_grid, c), dm.nu, n)
         coefficients = InputCoefficients(c, A_stage)
         coef0 = carriage.coefficients
@@ -182,7 +179,6 @@ def case_terms(problem: FitProblem, i: int, theta_s: ca.MX, transcription: Trans
     scaled_measured = (F2 / report_scale[None, :]).ravel(order="F")
     x_resid = None
     if carriage is not None:
-        B0 = sparse_dm(carriage.design(t))
         x_resid = ca.mtimes(B0, coef) - ca.DM(carriage.displacement)
         ex = x_resid / carriage.displacement_noise
         e = ca.vertcat(e, ex)
