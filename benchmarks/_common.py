@@ -19,3 +19,18 @@ def median_time(fn, *, repeat: int = 20, warmup: int = 2) -> float:
         fn()
         times.append(time.perf_counter() - t0)
     return statistics.median(times)
+
+
+def median_times(fn, *, repeat: int = 5, warmup: int = 1) -> tuple[float, float]:
+    """Median wall and CPU (process) time of ``fn()`` in seconds. On a shared machine the
+    CPU time of single-threaded code is the steadier of the two: other jobs lengthen the
+    wall time of a run, hardly its CPU time."""
+    for _ in range(warmup):
+        fn()
+    wall, cpu = [], []
+    for _ in range(repeat):
+        t0, c0 = time.perf_counter(), time.process_time()
+        fn()
+        wall.append(time.perf_counter() - t0)
+        cpu.append(time.process_time() - c0)
+    return statistics.median(wall), statistics.median(cpu)
