@@ -46,6 +46,9 @@ class Proposal:
     #: start values of the new parameters read off the amplitude evidence, for a fit
     #: started from the tank prediction instead of the current estimates (``None``: none)
     cold_start: Mapping[str, float] | None = None
+    #: the objective reduction the candidate's screening predicts, over the residual
+    #: variance (a score statistic; NaN: none, e.g. a spring with a held length)
+    score: float = math.nan
     plausible: Callable[[FitResult], str | None] = field(default=lambda r: None, repr=False)
     describe: Callable[[FitResult], str] = field(default=lambda r: "", repr=False)
 
@@ -222,7 +225,7 @@ def propose(model: Model, measurement: tuple[MeasurementModel, ...], current: Fi
     states, change a held parameter or shift the data): another slosh mode (matched scan),
     a diaphragm's hinge spring with the length held near the prediction, a sensor delay
     (profiled, when the residual leans toward a late recording) and, on a rotating rig, a
-    rotor."""
+    rotor. A matched scan's score is the proposal's :attr:`Proposal.score`."""
     values = dict(zip(current.names, current.values))
     out: list[Proposal] = []
     if len(current.channels[0] if current.channels else ()) > 1:
@@ -274,6 +277,7 @@ def propose(model: Model, measurement: tuple[MeasurementModel, ...], current: Fi
         out.append(Proposal(
             "slosh_mode", (name,), model + Pendulum(name) + HingeDamper(name), measurement,
             {f"{name}.mass": m0, f"{name}.length": L0, f"{name}.damping": c0},
+            score=statistic,
             bounds={f"{name}.length": (0.8 * L0, 1.25 * L0),
                     f"{name}.mass": (1e-6, min(m1, max(5 * predicted.get(f"{name}.mass", 0.0), 0.1 * m1)))},
             plausible=plausible_mode,

@@ -5,13 +5,15 @@ from __future__ import annotations
 
 import math
 from collections.abc import Sequence
+from typing import NamedTuple
 
 import numpy as np
 
 from ..fitting.result import FitResult
 from .evidence import NOISE_MARGIN
 
-__all__ = ["holdout_weights", "heldout", "bic", "poor_start", "POOR_START_VARIANCE"]
+__all__ = ["HeldOut", "holdout_weights", "heldout", "bic", "far_from_noise", "poor_start",
+           "POOR_START_VARIANCE"]
 
 
 def holdout_weights(n: int, *, blocks: int = 10, held: Sequence[int] = (1, 4, 7)) -> np.ndarray:
@@ -23,8 +25,18 @@ def holdout_weights(n: int, *, blocks: int = 10, held: Sequence[int] = (1, 4, 7)
     return w
 
 
-def heldout(res: FitResult) -> tuple[float, float]:
-    """Held-out RMS residual (N, or channel scales) and held-out chi-square.
+class HeldOut(NamedTuple):
+    """Held-out residual of a fit: RMS (N, or channel scales), chi-square (residuals in
+    noise units) and the chi-square the measurement noise alone would give (its expected
+    value: the number of independent held-out samples)."""
+
+    rms: float
+    chi2: float
+    noise_chi2: float
+
+
+def heldout(res: FitResult) -> HeldOut:
+    """Held-out RMS residual (N, or channel scales), chi-square and its noise-only value.
 
     With an estimated input, the carriage motion in held-out blocks rests on the
     displacement alone, whose noise makes acceleration noise above the signal band: the
@@ -33,7 +45,7 @@ def heldout(res: FitResult) -> tuple[float, float]:
     chi-square counts one independent sample per ``fs / (2 band)`` samples."""
     from ..data.signals import lowpass
 
-    num = chi2 = 0.0
+    num = chi2 = expected = 0.0
     cnt = 0
     for i, w in enumerate(res.weights):
         out = w == 0
@@ -58,7 +70,9 @@ def heldout(res: FitResult) -> tuple[float, float]:
         num += float(np.sum((r / report) ** 2))
         chi2 += float(np.sum((r / cost) ** 2)) * factor
         cnt += r.size
-    return (math.sqrt(num / cnt), chi2) if cnt else (res.rms_residual, math.nan)
+        expected += r.size * factor
+    return HeldOut(math.sqrt(num / cnt), chi2, expected) if cnt else \
+        HeldOut(res.rms_residual, math.nan, math.nan)
 
 
 def _weighted(res: FitResult) -> bool:
@@ -80,9 +94,15 @@ def bic(res: FitResult, extra_params: int = 0) -> float:
 POOR_START_VARIANCE = 4.0
 
 
+def far_from_noise(current: FitResult) -> bool:
+    """The fit's residual variance (in units of the noise variance) is above
+    :data:`POOR_START_VARIANCE`."""
+    v0 = current.residual_variance
+    return math.isfinite(v0) and v0 > POOR_START_VARIANCE
+
+
 def poor_start(current: FitResult, res: FitResult) -> bool:
-    """The current estimates are far from the data and the candidate started from them did
-    not reach the noise (residual variances in units of the noise variance)."""
-    v0, v1 = current.residual_variance, res.residual_variance
-    return (math.isfinite(v0) and v0 > POOR_START_VARIANCE
-            and (not res.converged or not v1 <= NOISE_MARGIN**2))
+    """The current estimates are far from the data and the candidate fit ``res`` did not
+    reach the noise (residual variances in units of the noise variance)."""
+    return far_from_noise(current) and (not res.converged
+                                        or not res.residual_variance <= NOISE_MARGIN**2)
