@@ -24,7 +24,7 @@ __all__ = ["HingeFriction", "CubicHingeSpring", "HingeTorqueTerms", "TORQUE_TERM
 #: Rate scale of the smoothed sign of dry friction [rad/s]: the torque is
 #: ``Tc tanh(rate / FRICTION_RATE)``, so below ~0.02 rad/s (a swing of 2 mrad at 2 Hz) the
 #: friction acts as a viscous damper ``Tc / FRICTION_RATE``; above, as Coulomb friction.
-FRICTION_RATE = 0.02
+FRICTION_RATE = 0.002
 
 
 class HingeFriction(Attachment):

@@ -119,18 +119,29 @@ def scan_mode(current: FitResult, f_lo: float, f_hi: float, *, n: int = 60, case
         from derive import Sampled
 
         excitation = Sampled(t, current.carriage[case])
-    best = None
-    for f in np.geomspace(f_lo, f_hi, n):
+
+    def trial(f: float, z: float) -> tuple[float, float, float]:
         om = 2 * math.pi * f
         L = g / om**2
         sim = simulate(probe, {"rig.dry_mass": 0.0, "rig.gravity": g, "q.mass": 1.0, "q.length": L,
-                               "q.damping": 2 * zeta * L**2 * om}, t, excitation,
+                               "q.damping": 2 * z * L**2 * om}, t, excitation,
                        outputs=("force_x",))
-        mass, explained = _probe_regression(sim.outputs[:, 0][w], J, r)
-        if mass <= 0:
-            continue
-        if best is None or explained > best[2]:
+        return (float(f), *_probe_regression(sim.outputs[:, 0][w], J, r))
+
+    best = None
+    for f in np.geomspace(f_lo, f_hi, n):
+        _, mass, explained = trial(f, zeta)
+        if mass > 0 and (best is None or explained > best[2]):
             best = (float(f), mass, explained)
+    if best is not None:
+        # refine between the neighbouring grid points with a probe as lightly damped as a
+        # slosh mode: a fit of a lightly damped mode started a grid step (2 %) off its
+        # frequency can ring out of phase and diverge
+        step = (f_hi / f_lo) ** (1 / max(n - 1, 1))
+        fine = [trial(f, 0.5 * zeta) for f in np.geomspace(best[0] / step, best[0] * step, 9)]
+        fine = [b for b in fine if b[1] > 0]
+        if fine:
+            best = max(fine, key=lambda b: b[2])
     return best
 
 
