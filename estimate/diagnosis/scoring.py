@@ -5,14 +5,13 @@ from __future__ import annotations
 
 import math
 from collections.abc import Sequence
-from typing import NamedTuple
 
 import numpy as np
 
 from ..fitting.result import FitResult
 from .evidence import NOISE_MARGIN
 
-__all__ = ["HeldOut", "holdout_weights", "heldout", "bic", "far_from_noise", "poor_start",
+__all__ = ["holdout_weights", "heldout", "bic", "far_from_noise", "poor_start",
            "POOR_START_VARIANCE"]
 
 
@@ -25,18 +24,8 @@ def holdout_weights(n: int, *, blocks: int = 10, held: Sequence[int] = (1, 4, 7)
     return w
 
 
-class HeldOut(NamedTuple):
-    """Held-out residual of a fit: RMS (N, or channel scales), chi-square (residuals in
-    noise units) and the chi-square the measurement noise alone would give (its expected
-    value: the number of independent held-out samples)."""
-
-    rms: float
-    chi2: float
-    noise_chi2: float
-
-
-def heldout(res: FitResult) -> HeldOut:
-    """Held-out RMS residual (N, or channel scales), chi-square and its noise-only value.
+def heldout(res: FitResult) -> tuple[float, float]:
+    """Held-out RMS residual (N, or channel scales) and held-out chi-square.
 
     With an estimated input, the carriage motion in held-out blocks rests on the
     displacement alone, whose noise makes acceleration noise above the signal band: the
@@ -45,7 +34,7 @@ def heldout(res: FitResult) -> HeldOut:
     chi-square counts one independent sample per ``fs / (2 band)`` samples."""
     from ..data.signals import lowpass
 
-    num = chi2 = expected = 0.0
+    num = chi2 = 0.0
     cnt = 0
     for i, w in enumerate(res.weights):
         out = w == 0
@@ -70,9 +59,7 @@ def heldout(res: FitResult) -> HeldOut:
         num += float(np.sum((r / report) ** 2))
         chi2 += float(np.sum((r / cost) ** 2)) * factor
         cnt += r.size
-        expected += r.size * factor
-    return HeldOut(math.sqrt(num / cnt), chi2, expected) if cnt else \
-        HeldOut(res.rms_residual, math.nan, math.nan)
+    return (math.sqrt(num / cnt), chi2) if cnt else (res.rms_residual, math.nan)
 
 
 def _weighted(res: FitResult) -> bool:

@@ -26,7 +26,8 @@ from dataclasses import replace
 
 import numpy as np
 
-from analogs import FixedMass, HingeDamper, LateralRig, Model, Pendulum
+from analogs import FixedMass, HingeDamper, HingeFriction, LateralRig, Model, Pendulum
+from analogs.hinge_nonlinear import FRICTION_RATE
 
 from ..data.case import Case
 from ..fitting.initial import predicted_values
@@ -48,11 +49,13 @@ __all__ = ["Diagnosis", "Finding", "CandidateOutcome", "diagnose", "baseline_mod
 MAX_BIC_CHANGE = -10.0
 #: Minimum held-out chi-square reduction (residuals in noise units) for accepting one.
 MIN_HELDOUT_CHI2 = 9.0
-#: Share of the held-out chi-square above the noise's (``chi2 - noise_chi2``) an extension
-#: must remove: when the current model is far from the data, a chi-square drop of 9 is
-#: lenient (a 15 N transducer saturation left 1.4x the noise, and dry friction cut its
-#: held-out chi-square by 37, 0.6 % of the excess, 0.3 % of the RMS); a real effect removes
-#: most of its own excess (friction_b: about all of it).
+#: Share of the objective's excess over the noise (``objective - dof``, residuals in noise
+#: units) an extension must remove: when the current model is far from the data, a held-out
+#: chi-square drop of 9 is lenient (a 15 N transducer saturation left 1.4x the noise, and
+#: dry friction cut the held-out chi-square by 37 but removed 2 % of the excess, 0.3 % of
+#: the held-out RMS); a real effect removes most of the excess it causes (friction_a: 87 %).
+#: (The held-out chi-square's own excess is no measure: with an estimated carriage motion
+#: the held-out blocks keep a carriage error a correct model does not remove.)
 MIN_EXCESS_SHARE = 0.1
 #: Score statistic a screened candidate needs to be fitted (5 standard deviations for one
 #: new parameter: a dozen candidates are screened each round).
@@ -283,11 +286,53 @@ def _diagnose(cases, max_bic_change: float, max_rounds: int, segments: int,
     bar.set_postfix_str("final fit")
     final = fitter(current.problem.model, current.problem.measurement, start,
                    _bounds_of(current), weights=None, warm=current)
+    final, sharpened = _sharpen_friction(fitter, final)
+    if sharpened:
+        notes.append(f"the final fit sharpens the dry friction's sign to tanh(rate / "
+                     f"{sharpened:g} rad/s) (the candidates' {FRICTION_RATE:g} rad/s biases the "
+                     f"friction torque high by a few per cent against sharp friction)")
     final_evidence = collect_evidence(final, segments=evidence.segments)
     verdict = Verdict.of(final_evidence, tuple(rounds), tuple(findings))
     return Diagnosis(base, base_evidence, tuple(findings), final, final_evidence,
                      tuple(rounds), fitter.count, time.perf_counter() - t0, tuple(notes),
                      verdict)
+
+
+#: Rate scales [rad/s] the final fit sharpens dry friction's sign to, one after the other:
+#: against sharp friction (noise-free), Tc came out +3.2 % at 0.02 rad/s (the candidates'),
+#: +1.4 % at 0.005 and +0.8 % at 0.002; each step, warm-started, took 10-30 iterations.
+SHARPER_FRICTION = (0.005, 0.002)
+#: A sharper rate is used only while ``h Tc / (rate m L^2)`` (the friction's stiffness over
+#: the hinge inertia, times the RK4 step) stays below this; RK4 is unstable above ~2.8.
+FRICTION_STIFFNESS = 1.0
+
+
+def _sharpen_friction(fitter: _Fitter, final: FitResult) -> tuple[FitResult, float | None]:
+    """Refit ``final`` with its hinge friction's sign sharpened along
+    :data:`SHARPER_FRICTION` (warm-started, each step kept when it converges and stays
+    stable for RK4). Returns the fit and the sharpest rate used (``None``: unchanged)."""
+    model = final.problem.model
+    hosts = [c for c in model.components if isinstance(c, HingeFriction)]
+    if not hosts:
+        return final, None
+    used = None
+    for rate in SHARPER_FRICTION:
+        ok = True
+        for c in hosts:
+            m, L = final.value(f"{c.host}.mass"), final.value(f"{c.host}.length")
+            tc = final.value(f"{c.host}.coulomb_friction")
+            h = max(float(np.median(np.diff(e.case.time))) for e in final.problem.experiments)
+            ok &= h * abs(tc) / (rate * m * L**2) <= FRICTION_STIFFNESS
+        if not ok:
+            break
+        sharper = Model(tuple(HingeFriction(c.host, rate=rate)
+                              if isinstance(c, HingeFriction) else c for c in model.components))
+        res = fitter(sharper, final.problem.measurement, dict(zip(final.names, final.values)),
+                     _bounds_of(final), weights=None, warm=final)
+        if not res.converged:
+            break
+        final, used = res, rate
+    return final, used
 
 
 #: Families whose start values and evidence read the amplitude trends of segment refits.
@@ -301,7 +346,7 @@ def _round(fitter: _Fitter, current: FitResult, evidence: Evidence, predicted, g
     segment refits of ``evidence`` are made here when it has none and a family that reads
     the amplitude trends is to be fitted."""
     measurement = tuple(current.problem.measurement)
-    rms0, chi0, noise0 = heldout(current)
+    rms0, chi0 = heldout(current)
     delays = sum(isinstance(m, SensorDelay) for m in measurement)
     bic0 = bic(current, delays)
     outcomes: list[CandidateOutcome] = []
@@ -367,7 +412,7 @@ def _round(fitter: _Fitter, current: FitResult, evidence: Evidence, predicted, g
                 score=score))
             continue
         out = _try(fitter, prop, current, score, rms0, chi0, bic0, delays, max_bic_change,
-                   noise0=noise0, profile=profiles.get(id(prop)))
+                   profile=profiles.get(id(prop)))
         outcomes.append(out)
         if out.rejected is None:
             achieved = max(achieved, current.objective - out.result.objective)
@@ -382,8 +427,7 @@ def _round(fitter: _Fitter, current: FitResult, evidence: Evidence, predicted, g
     if lib is not None and not any(o.rejected is None for o in outcomes):
         # the library route: a hinge torque term no named family describes
         outcomes.append(_try(fitter, _library_proposal(lib, current, evidence, inertia),
-                             current, lib.statistic, rms0, chi0, bic0, delays, max_bic_change,
-                             noise0=noise0))
+                             current, lib.statistic, rms0, chi0, bic0, delays, max_bic_change))
     outcomes.sort(key=lambda o: (o.rejected is not None,
                                  -(o.heldout_chi2 if math.isfinite(o.heldout_chi2) else -1e300),
                                  -(o.gain if math.isfinite(o.gain) else -1e300)))
@@ -402,7 +446,7 @@ def _not_fitted(sc, current: FitResult, rms0: float, why: str) -> CandidateOutco
 
 def _try(fitter: _Fitter, prop: Proposal, current: FitResult, score: float, rms0: float,
          chi0: float, bic0: float, delays: int, max_bic_change: float, *,
-         noise0: float = math.nan, profile: DelayProfile | None = None) -> CandidateOutcome:
+         profile: DelayProfile | None = None) -> CandidateOutcome:
     start = {n: v for n, v in zip(current.names, current.values) if ":" not in n}
     start |= dict(prop.initial)
     try:
@@ -431,20 +475,22 @@ def _try(fitter: _Fitter, prop: Proposal, current: FitResult, score: float, rms0
     except (ValueError, RuntimeError) as err:
         return CandidateOutcome(prop.cause, prop.added, rms0, math.nan, -math.inf, math.inf,
                                 f"fit failed: {err}", "", current, score=score)
-    rms1, chi1, _ = heldout(res)
+    rms1, chi1 = heldout(res)
     gain = 1 - rms1 / rms0
     dchi = chi0 - chi1
+    # with noise-weighted residuals the objective at the noise is its degrees of freedom
+    weighted = bool(current.problem.noise) and all(n is not None for n in current.problem.noise)
+    drop, excess = current.objective - res.objective, current.objective - current.dof
     dbic = bic(res, extra + delays) - bic0
     if not res.converged:
         reason = f"the fit did not converge ({res.status})"
     elif not dchi >= MIN_HELDOUT_CHI2:
         reason = (f"held-out chi-square fell by {dchi:.1f} (needs {MIN_HELDOUT_CHI2:.0f}; "
                   f"held-out RMS gain {100 * gain:.1f} %)")
-    elif not dchi >= MIN_EXCESS_SHARE * (chi0 - noise0):  # False for NaN: not checked
-        reason = (f"held-out chi-square fell by {dchi:.1f}, {100 * dchi / (chi0 - noise0):.1f} % "
-                  f"of its {chi0 - noise0:.0f} above the noise (needs "
-                  f"{100 * MIN_EXCESS_SHARE:.0f} %; held-out RMS gain {100 * gain:.1f} %): the "
-                  f"model stays misspecified and this bends around it")
+    elif weighted and excess > 0 and not drop >= MIN_EXCESS_SHARE * excess:
+        reason = (f"it removed {drop:.0f} of the {excess:.0f} the objective exceeds the noise "
+                  f"by ({100 * drop / excess:.1f} %, needs {100 * MIN_EXCESS_SHARE:.0f} %; held-out "
+                  f"RMS gain {100 * gain:.1f} %): it bends around an effect it does not describe")
     elif dbic > max_bic_change:
         reason = f"BIC change {dbic:+.1f} is not below {max_bic_change:+.0f}"
     else:
