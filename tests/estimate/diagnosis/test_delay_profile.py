@@ -1,21 +1,22 @@
 """The sensor delay's linearised profile (``estimate.diagnosis.screening.delay_profile``):
 on a record of the independent reference simulator whose force is recorded 30 ms late, the
 profile linearised at the fit without delay has its minimum at the simulated delay, and
-its predicted objective there agrees with an actual fit at that delay.
+the objective reduction it predicts there agrees with an actual fit at that delay.
 
 Tolerances: the delay within 1 ms (a tenth of the 10 ms sample interval; the fitted delay
 of the old nine-fit profile search agreed with the simulated one to 0.2 ms); the predicted
-objective within 15 % of the fitted one (one Gauss-Newton step from a fit 30 ms off; the
-profile is only used to place the fit)."""
+reduction within 5 % of the fitted one (one Gauss-Newton step from a fit 30 ms off: the
+remaining objective itself is predicted only to a factor of ~3, the profile serves to
+place the fit)."""
 
 import numpy as np
 import pytest
 import reference_models as ref
 from synthetic_cases import make_case, pendulum
 
+from estimate.diagnosis.scoring import holdout_weights
 from estimate.diagnosis.screening import delay_profile
 from estimate.diagnosis.search import _Fitter, baseline_model, force_cutoff
-from estimate.diagnosis.scoring import holdout_weights
 from estimate.fitting.linearise import linearise
 from estimate.fitting.measurement import SensorDelay
 
@@ -36,5 +37,4 @@ def test_linearised_delay_profile_finds_the_simulated_delay(tmp_path):
     at = fitter(model, (SensorDelay(round(prof.best, 5)),), dict(zip(base.names, base.values)),
                 warm=base)
     assert at.converged
-    assert prof.objective[int(np.argmin(prof.objective))] == pytest.approx(at.objective, rel=0.15)
-    assert prof.reduction == pytest.approx(base.objective - at.objective, rel=0.15)
+    assert prof.reduction == pytest.approx(base.objective - at.objective, rel=0.05)
