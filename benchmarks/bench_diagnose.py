@@ -33,6 +33,7 @@ KINDS = {
     "hardening hinge (diaphragm)": "cubic_b",
     "second mode + sensor delay": "mode_delay",
     "outside: asymmetric hinge": "outside_asymmetric",
+    "outside: transducer saturation": "outside_saturation",
 }
 
 

@@ -46,6 +46,9 @@ class Proposal:
     #: start values of the new parameters read off the amplitude evidence, for a fit
     #: started from the tank prediction instead of the current estimates (``None``: none)
     cold_start: Mapping[str, float] | None = None
+    #: the objective reduction the candidate's screening predicts, over the residual
+    #: variance (a score statistic; NaN: none, e.g. a spring with a held length)
+    score: float = math.nan
     plausible: Callable[[FitResult], str | None] = field(default=lambda r: None, repr=False)
     describe: Callable[[FitResult], str] = field(default=lambda r: "", repr=False)
 
@@ -116,18 +119,29 @@ def scan_mode(current: FitResult, f_lo: float, f_hi: float, *, n: int = 60, case
         from derive import Sampled
 
         excitation = Sampled(t, current.carriage[case])
-    best = None
-    for f in np.geomspace(f_lo, f_hi, n):
+
+    def trial(f: float, z: float) -> tuple[float, float, float]:
         om = 2 * math.pi * f
         L = g / om**2
         sim = simulate(probe, {"rig.dry_mass": 0.0, "rig.gravity": g, "q.mass": 1.0, "q.length": L,
-                               "q.damping": 2 * zeta * L**2 * om}, t, excitation,
+                               "q.damping": 2 * z * L**2 * om}, t, excitation,
                        outputs=("force_x",))
-        mass, explained = _probe_regression(sim.outputs[:, 0][w], J, r)
-        if mass <= 0:
-            continue
-        if best is None or explained > best[2]:
+        return (float(f), *_probe_regression(sim.outputs[:, 0][w], J, r))
+
+    best = None
+    for f in np.geomspace(f_lo, f_hi, n):
+        _, mass, explained = trial(f, zeta)
+        if mass > 0 and (best is None or explained > best[2]):
             best = (float(f), mass, explained)
+    if best is not None:
+        # refine between the neighbouring grid points with a probe as lightly damped as a
+        # slosh mode: a fit of a lightly damped mode started a grid step (2 %) off its
+        # frequency can ring out of phase and diverge
+        step = (f_hi / f_lo) ** (1 / max(n - 1, 1))
+        fine = [trial(f, 0.5 * zeta) for f in np.geomspace(best[0] / step, best[0] * step, 9)]
+        fine = [b for b in fine if b[1] > 0]
+        if fine:
+            best = max(fine, key=lambda b: b[2])
     return best
 
 
@@ -222,7 +236,7 @@ def propose(model: Model, measurement: tuple[MeasurementModel, ...], current: Fi
     states, change a held parameter or shift the data): another slosh mode (matched scan),
     a diaphragm's hinge spring with the length held near the prediction, a sensor delay
     (profiled, when the residual leans toward a late recording) and, on a rotating rig, a
-    rotor."""
+    rotor. A matched scan's score is the proposal's :attr:`Proposal.score`."""
     values = dict(zip(current.names, current.values))
     out: list[Proposal] = []
     if len(current.channels[0] if current.channels else ()) > 1:
@@ -274,6 +288,7 @@ def propose(model: Model, measurement: tuple[MeasurementModel, ...], current: Fi
         out.append(Proposal(
             "slosh_mode", (name,), model + Pendulum(name) + HingeDamper(name), measurement,
             {f"{name}.mass": m0, f"{name}.length": L0, f"{name}.damping": c0},
+            score=statistic,
             bounds={f"{name}.length": (0.8 * L0, 1.25 * L0),
                     f"{name}.mass": (1e-6, min(m1, max(5 * predicted.get(f"{name}.mass", 0.0), 0.1 * m1)))},
             plausible=plausible_mode,

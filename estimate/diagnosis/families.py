@@ -6,6 +6,8 @@ from __future__ import annotations
 
 import math
 
+from analogs.hinge_nonlinear import FRICTION_RATE
+
 from ..fitting.result import FitResult
 from .candidates import Proposal
 from .evidence import Evidence
@@ -98,7 +100,7 @@ def _describe(cause: str, names: tuple[str, ...], r: FitResult, evidence: Eviden
         tc = v[f"{host}.coulomb_friction"]
         return (f"{_trend_text(evidence, 'damping')}{statistic} -> dry (Coulomb) friction at the "
                 f"hinge, whose equivalent damping falls with the swing; adding a friction torque "
-                f"Tc = {tc:.3g} N m on {host} (tanh of the rate over 0.02 rad/s)")
+                f"Tc = {tc:.3g} N m on {host} (tanh of the rate over {FRICTION_RATE:g} rad/s)")
     if cause == "nonlinear_damping":
         c2 = v[f"{host}.quadratic_damping"]
         return (f"{_trend_text(evidence, 'damping')}{statistic} -> damping that grows with the "

@@ -11,7 +11,8 @@ import numpy as np
 from ..fitting.result import FitResult
 from .evidence import NOISE_MARGIN
 
-__all__ = ["holdout_weights", "heldout", "bic", "poor_start", "POOR_START_VARIANCE"]
+__all__ = ["holdout_weights", "heldout", "bic", "far_from_noise", "poor_start",
+           "POOR_START_VARIANCE"]
 
 
 def holdout_weights(n: int, *, blocks: int = 10, held: Sequence[int] = (1, 4, 7)) -> np.ndarray:
@@ -80,9 +81,15 @@ def bic(res: FitResult, extra_params: int = 0) -> float:
 POOR_START_VARIANCE = 4.0
 
 
+def far_from_noise(current: FitResult) -> bool:
+    """The fit's residual variance (in units of the noise variance) is above
+    :data:`POOR_START_VARIANCE`."""
+    v0 = current.residual_variance
+    return math.isfinite(v0) and v0 > POOR_START_VARIANCE
+
+
 def poor_start(current: FitResult, res: FitResult) -> bool:
-    """The current estimates are far from the data and the candidate started from them did
-    not reach the noise (residual variances in units of the noise variance)."""
-    v0, v1 = current.residual_variance, res.residual_variance
-    return (math.isfinite(v0) and v0 > POOR_START_VARIANCE
-            and (not res.converged or not v1 <= NOISE_MARGIN**2))
+    """The current estimates are far from the data and the candidate fit ``res`` did not
+    reach the noise (residual variances in units of the noise variance)."""
+    return far_from_noise(current) and (not res.converged
+                                        or not res.residual_variance <= NOISE_MARGIN**2)

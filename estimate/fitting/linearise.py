@@ -5,11 +5,15 @@ families with it (:mod:`estimate.diagnosis.screening`)."""
 
 from __future__ import annotations
 
-from dataclasses import dataclass
+from dataclasses import dataclass, field
+from functools import cached_property
 
 import casadi as ca
 import numpy as np
+import scipy.sparse as sps
+import scipy.sparse.linalg as spla
 
+from .covariance import ReducedKKT
 from .nlp import _setup
 from .problem import FitProblem
 from .result import FitResult
@@ -34,6 +38,10 @@ class Linearisation:
     objective: float
     gradient: np.ndarray
     information: np.ndarray
+    #: the reduced KKT system at the start and its residuals ``e`` and constraint values
+    kkt: ReducedKKT | None = field(default=None, repr=False, compare=False)
+    residuals: np.ndarray | None = field(default=None, repr=False, compare=False)
+    constraints: np.ndarray | None = field(default=None, repr=False, compare=False)
 
     def score(self, free: tuple[str, ...]) -> tuple[float, dict[str, float]]:
         """The objective reduction of one Gauss-Newton step in the parameters ``free`` (the
@@ -51,6 +59,41 @@ class Linearisation:
                  for n, i, xi in zip(free, idx, x)}
         return float(b @ x), after
 
+    @cached_property
+    def _nuisance_solve(self):
+        """``B -> K0^-1 B`` for many right-hand sides: SuperLU of the KKT block of every
+        variable but the parameters (pivoted, so the saddle point needs no regularisation)."""
+        kkt = self.kkt
+        p = kkt.ntheta
+        if kkt.n_primal + kkt.ng == 0:
+            return lambda B: B
+        Hrr = (kkt.Je[:, p:].T @ kkt.Je[:, p:]).tocsc()
+        Gr = kkt.Jg[:, p:]
+        K0 = sps.bmat([[Hrr, Gr.T], [Gr, None]], format="csc") if kkt.ng else Hrr
+        return spla.splu(K0).solve
+
+    def objectives(self, residuals: np.ndarray, free: tuple[str, ...]) -> np.ndarray:
+        """The objective after one Gauss-Newton step from each column of ``residuals``
+        (residual vectors ``e`` of other data, e.g. the recorded force shifted in time, at
+        the same point): the parameters ``free`` and every variable but the other
+        parameters (states through the linearised constraints, the carriage motion and free
+        initial states) move. One multi-right-hand-side solve with the factorisation of the
+        start; for columns equal to :attr:`residuals` the reduction is :meth:`score`'s."""
+        kkt = self.kkt
+        if kkt is None:
+            raise ValueError("this Linearisation keeps no KKT system: make it with `linearise`")
+        E = np.asarray(residuals, float).reshape(len(self.residuals), -1)
+        p, m = kkt.ntheta, E.shape[1]
+        b = -(kkt.Je.T @ E)
+        g = np.zeros(kkt.ng) if self.constraints is None else self.constraints
+        b_r = np.vstack([b[p:], np.repeat(-g[:, None], m, axis=1)])
+        y = self._nuisance_solve(b_r)
+        nuisance = np.sum(b[p:] * y[:kkt.n_primal], axis=0)
+        bt = b[:p] - kkt.B.T @ y
+        idx = [self.names.index(n) for n in free]
+        x = np.linalg.lstsq(self.information[np.ix_(idx, idx)], bt[idx], rcond=1e-12)[0]
+        return np.sum(E**2, axis=0) - nuisance - np.sum(bt[idx] * x, axis=0)
+
 
 def linearise(problem: FitProblem, *, warm_start: FitResult | None = None,
               transcription: Transcription = MultipleShooting(),
@@ -58,8 +101,6 @@ def linearise(problem: FitProblem, *, warm_start: FitResult | None = None,
     """The :class:`Linearisation` of ``problem`` at its initial values, its states and
     carriage motion starting from ``warm_start`` (the current fit): what fitting it would
     gain, predicted without solving (one sparse factorisation)."""
-    from .covariance import ReducedKKT
-
     est = problem.estimated
     kinds = [initial_state or e.initial_state_kind for e in problem.experiments]
     nlp, _ = _setup(problem, transcription, "squared", kinds, True, False, warm_start)
@@ -73,4 +114,4 @@ def linearise(problem: FitProblem, *, warm_start: FitResult | None = None,
     kkt = ReducedKKT(Je, Jg.sparse(), len(est))
     scales = np.array([x.scale for x in est])
     return Linearisation(problem.names, scales, problem.initial, float(e @ e),
-                         kkt.gradient(e, g), kkt.information)
+                         kkt.gradient(e, g), kkt.information, kkt, e, g)
