@@ -289,7 +289,7 @@ def _round(fitter: _Fitter, current: FitResult, evidence: Evidence, predicted, g
         proposals += [(p, math.nan) for p in propose(
             current.problem.model, measurement, current, evidence, gravity=gravity,
             predicted=predicted)]
-        library = []
+        named, library = [], []
     for prop, score in proposals:
         outcomes.append(_try(fitter, prop, current, score, rms0, chi0, bic0, delays,
                              max_bic_change))

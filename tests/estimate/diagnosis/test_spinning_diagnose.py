@@ -48,3 +48,31 @@ def test_rotor_hidden_in_spinning_data_is_named_with_evidence(tmp_path):
     base = {k: v["value"] for k, v in d.to_dict()["baseline"]["parameters"].items()}
     assert base["p1.mass"] == pytest.approx(PEND.mass, rel=0.05)
     assert final["p1.mass"] == pytest.approx(PEND.mass, rel=0.05)
+
+
+#: A rotary oscillator (Green et al.) of 2e-3 kg m^2 with its natural frequency at 16 rad/s
+#: (2.55 Hz) and 5 % damping: in the tank spinning at 6 rad/s its slower circular mode is at
+#: 10 rad/s, just above the 9.1 rad/s at which the tank sees the nutation, so the tangential
+#: torque resonates while the forces (the pendulum's) do not.
+OSC_INERTIA, OSC_OMEGA, OSC_ZETA = 2e-3, 16.0, 0.05
+#: Issue 16 acceptance: the oscillator's natural frequency within 2 %.
+OSC_FREQ_TOL = 0.02
+
+
+@pytest.mark.slow
+def test_rotary_oscillator_hidden_in_spinning_data_is_named_with_its_frequency(tmp_path):
+    import math
+
+    osc = rs.RotaryOscillator(OSC_INERTIA, OSC_INERTIA * OSC_OMEGA**2,
+                              2 * OSC_ZETA * OSC_INERTIA * OSC_OMEGA)
+    case, sim = make_spinning_case(tmp_path, "O1", RIG, pendulum=PEND, oscillator=osc,
+                                   fixed_mass=1.5, fixed_height=0.05, noise=0.015,
+                                   tone=(0.02, 23.0), seed=7, tank_radius=0.1016,
+                                   duration=20.0)
+    d = diagnose(case)
+    assert [f.cause for f in d.findings][:1] == ["rotary_oscillator"], d.rounds
+    finding = d.findings[0]
+    assert finding.added == ("o1",) and "torque" in finding.evidence
+    final = {k: v["value"] for k, v in d.to_dict()["final"]["parameters"].items()}
+    f_hz = math.sqrt(final["o1.stiffness"] / final["o1.inertia"]) / (2 * math.pi)
+    assert f_hz == pytest.approx(OSC_OMEGA / (2 * math.pi), rel=OSC_FREQ_TOL)
