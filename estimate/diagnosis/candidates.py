@@ -265,7 +265,7 @@ def _rotary_proposal(model: Model, measurement, current: FitResult, evidence: Ev
     name = next(f"o{k}" for k in range(1, 99)
                 if not any(c.name == f"o{k}" for c in model.components))
     axes = rotary_axes(model.rig)
-    tangential = f"torque_{axes[1]}"
+    top = max(shares, key=shares.get)
 
     def plausible_rotary(r: FitResult) -> str | None:
         for k in (f"{name}.inertia", f"{name}.stiffness"):
@@ -280,8 +280,8 @@ def _rotary_proposal(model: Model, measurement, current: FitResult, evidence: Ev
     def describe_rotary(r: FitResult) -> str:
         f = r.derived.get(f"{name}.frequency_hz", (math.nan, 0.0))[0]
         return (f"the residual is concentrated in the torques ({100 * torques:.0f} % of the "
-                f"scaled residual power; tangential {tangential} "
-                f"{100 * shares.get(tangential, 0):.0f} %) with little force, which the pendulum "
+                f"scaled residual power; largest share {top} {100 * shares.get(top, 0):.0f} %) "
+                f"with little force, which the pendulum "
                 f"cannot produce; {100 * explained:.0f} % of it is the torque of an oscillator "
                 f"resonating near {w0 / (2 * math.pi):.3g} Hz (a rotor explains "
                 f"{100 * rotor_explained:.0f} %) -> a rotary torque resonance of the liquid; "
