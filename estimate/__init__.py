@@ -30,6 +30,7 @@ from .data.models import BASELINE, model_from_spec
 from .data.reader import load_case
 from .data.writer import write_case
 from .diagnosis.search import Diagnosis, Finding, diagnose
+from .fitting.measurement import ChannelOffsets
 from .fitting.nlp import Hessian, fit
 from .fitting.problem import FitProblem
 from .fitting.profile import profile_interval
@@ -40,6 +41,7 @@ __all__ = [
     "BASELINE",
     "Case",
     "CaseError",
+    "ChannelOffsets",
     "Collocation",
     "Diagnosis",
     "Experiment",

@@ -27,6 +27,10 @@ def add_parser(sub: argparse._SubParsersAction) -> None:
                         "--cost abs)")
     p.add_argument("--cost", choices=("squared", "abs"), default="squared",
                    help="sum of squared residuals (default) or the seed's sum((|E|-|S|)^2)")
+    p.add_argument("--channel-offsets", choices=("none", "offset", "drift"), default="none",
+                   help="estimate a zero offset ('offset') or an offset and a linear drift "
+                        "('drift') of every measured channel with the parameters, per case "
+                        "(a transducer that is not zeroed or drifts); default: none")
     p.add_argument("--json", dest="json_out", default=None, help="write the result as JSON")
     p.add_argument("--plot", default=None, help="write the fit plots (PNG) of the first case")
     p.add_argument("--report", action="store_true", help="print the full text fit report")
@@ -38,6 +42,7 @@ def run(args: argparse.Namespace) -> int:
     import sys
 
     from ..data.models import BASELINE, model_from_spec
+    from ..fitting.measurement import ChannelOffsets
     from ..fitting.nlp import fit
     from ..fitting.problem import FitProblem
     from ..fitting.transcription import Collocation, MultipleShooting
@@ -50,7 +55,9 @@ def run(args: argparse.Namespace) -> int:
     spec = BASELINE if args.model is None else args.model
     model = model_from_spec(spec, cases[0])
     mode = args.input or ("filtered" if args.cost == "abs" else "estimated")
-    problem = FitProblem.build(cases, model, input=mode)
+    measurement = (() if args.channel_offsets == "none"
+                   else (ChannelOffsets(drift=args.channel_offsets == "drift"),))
+    problem = FitProblem.build(cases, model, input=mode, measurement=measurement)
     tr = MultipleShooting() if args.transcription == "multiple_shooting" else Collocation()
     result = fit(problem, transcription=tr, cost=args.cost)
     if args.report or sys.stdout.isatty():

@@ -25,7 +25,15 @@ FREQUENCY_OFF = 0.03
 #: The causes a diagnosis can name (documented in the README).
 CAUSES = ("slosh_mode", "nonlinear_damping", "dry_friction", "nonlinear_stiffness",
           "diaphragm_stiffness", "sensor_delay", "sensor_offset", "rig_friction", "rotor",
-          "hinge_torque")
+          "rotary_oscillator", "hinge_torque")
+
+#: Damping ratio of the rotary-oscillator probe of :func:`scan_rotary`: more than a slosh
+#: resonance has, so that a trial frequency a grid step from a sharp resonance still
+#: correlates with its response.
+ROTARY_PROBE_DAMPING = 0.05
+#: The rotary oscillator is proposed only when its scan explains this much more of the
+#: residual than the rotor scan (an oscillator with a soft spring imitates a rotor).
+ROTARY_MARGIN = 0.05
 
 
 @dataclass(frozen=True)
@@ -179,7 +187,7 @@ def scan_rotor(current: FitResult, *, case: int = 0, n: int = 16,
     best = None
     for rate in np.geomspace(*rates, n):
         sim = simulate(probe, {**values, "q.inertia": 1.0, "q.damping": float(rate)}, t,
-                       integrator=RK4(), outputs=chans)
+                       exp.excitation, integrator=RK4(), outputs=chans)
         y = (sim.outputs / scales[None, :]).ravel(order="F")[w]
         inertia, explained = _probe_regression(y, J, r)
         if inertia <= 0:
@@ -189,8 +197,122 @@ def scan_rotor(current: FitResult, *, case: int = 0, n: int = 16,
     return best
 
 
+def _spin_residual(current: FitResult, case: int):
+    """The (scaled, channel-major) residual of ``case`` on its fitted samples, the fit's
+    sensitivity rows for them, the channels and their scales."""
+    import numpy as np
+
+    chans = current.channels[case]
+    scales = np.array([current.channel_scales[case][c] for c in chans])
+    w = np.tile(current.weights[case] > 0, len(chans))
+    r = (current.residuals[case] / scales).ravel(order="F")[w]
+    offset = sum(int(np.size(current.residuals[k])) for k in range(case))
+    J = current.sensitivity[offset:offset + r.size + int(np.count_nonzero(~w))][w]
+    return r, J, chans, scales, w
+
+
+def rotary_axes(rig) -> str:
+    """The axes of a :class:`~analogs.RotaryOscillator` about the tank's radial and
+    tangential directions: ``"xy"`` when the tank axis is the spin axis, ``"zy"`` when it
+    points inward (:class:`~analogs.SpinningRig` ``tank_axis``)."""
+    return "xy" if rig.tank_axis == "spin" else "zy"
+
+
+def scan_rotary(current: FitResult, *, case: int = 0, n: int = 24,
+                ratios: tuple[float, float] = (1.05, 6.0)) -> tuple[float, float, float] | None:
+    """Matched scan for an unmodelled rotary oscillator (Green et al.) on a rotating rig:
+    for trial natural frequencies ``omega_0`` (rad/s) from ``ratios`` times the spin rate
+    (above it, where an oscillator damped relative to the tank is stable), simulate a
+    unit-inertia oscillator with stiffness ``omega_0^2`` and damping ratio
+    :data:`ROTARY_PROBE_DAMPING` on the case's rig motion, and regress the (scaled,
+    all-channel) residual on its outputs together with the current fit's sensitivity
+    columns. Its torques are proportional to its inertia at a given frequency and damping
+    ratio. Returns ``(inertia, natural_frequency_rad_s, explained_fraction)`` of the best
+    trial with a positive inertia, or ``None`` (the rig does not rotate, or nothing
+    explained)."""
+    import numpy as np
+
+    from analogs import RotaryOscillator, SpinningRig
+    from derive import RK4, derive, simulate
+
+    problem = current.problem
+    rig = problem.model.rig
+    spin = problem.experiments[case].case.spin
+    if not isinstance(rig, SpinningRig) or spin is None or not spin.rate:
+        return None
+    exp = problem.experiments[case]
+    t = np.asarray(exp.case.time, float)
+    r, J, chans, scales, w = _spin_residual(current, case)
+    probe = derive(Model((rig,)) + RotaryOscillator("q", axes=rotary_axes(rig)))
+    values = {k: v for k, v in problem.case_values(case, current.values).items()
+              if k.startswith("rig.")}
+    values["rig.dry_mass"] = 0.0
+    best = None
+    for w0 in abs(spin.rate) * np.geomspace(*ratios, n):
+        sim = simulate(probe, {**values, "q.inertia": 1.0, "q.stiffness": float(w0**2),
+                               "q.damping": 2 * ROTARY_PROBE_DAMPING * float(w0)}, t,
+                       exp.excitation, integrator=RK4(), outputs=chans)
+        y = (sim.outputs / scales[None, :]).ravel(order="F")[w]
+        inertia, explained = _probe_regression(y, J, r)
+        if inertia <= 0:
+            continue
+        if best is None or explained > best[2]:
+            best = (inertia, float(w0), explained)
+    return best
+
+
+def _rotary_proposal(model: Model, measurement, current: FitResult, evidence: Evidence,
+                     rotor_explained: float) -> Proposal | None:
+    """A rotary oscillator when the residual is mostly torque and an oscillator above the
+    spin rate explains clearly more of it than a rotor does (``rotor_explained``)."""
+    from analogs import RotaryOscillator
+
+    shares = evidence.channel_share
+    torques = sum(v for k, v in shares.items() if k.startswith("torque"))
+    if torques < 0.5:
+        return None
+    scan = scan_rotary(current)
+    if scan is None or scan[2] < rotor_explained + ROTARY_MARGIN:
+        return None
+    inertia, w0, explained = scan
+    spin = abs(current.problem.experiments[0].case.spin.rate)
+    name = next(f"o{k}" for k in range(1, 99)
+                if not any(c.name == f"o{k}" for c in model.components))
+    axes = rotary_axes(model.rig)
+    top = max(shares, key=shares.get)
+
+    def plausible_rotary(r: FitResult) -> str | None:
+        for k in (f"{name}.inertia", f"{name}.stiffness"):
+            if not _significant(r, k, 3.0):
+                return f"`{k}` = {r.value(k):.3g} is not distinguishable from zero"
+        f = r.derived.get(f"{name}.frequency_hz", (math.nan, 0.0))[0]
+        if not 2 * math.pi * f > spin:
+            return (f"natural frequency {f:.3g} Hz is not above the spin rate "
+                    f"({spin / (2 * math.pi):.3g} Hz): unstable with damping in the tank")
+        return None
+
+    def describe_rotary(r: FitResult) -> str:
+        f = r.derived.get(f"{name}.frequency_hz", (math.nan, 0.0))[0]
+        return (f"the residual is concentrated in the torques ({100 * torques:.0f} % of the "
+                f"scaled residual power; largest share {top} {100 * shares.get(top, 0):.0f} %) "
+                f"with little force, which the pendulum "
+                f"cannot produce; {100 * explained:.0f} % of it is the torque of an oscillator "
+                f"resonating near {w0 / (2 * math.pi):.3g} Hz (a rotor explains "
+                f"{100 * rotor_explained:.0f} %) -> a rotary torque resonance of the liquid; "
+                f"adding rotary oscillator {name} (inertia {r.value(f'{name}.inertia'):.3g} "
+                f"kg m^2, natural frequency {f:.4g} Hz, damping ratio "
+                f"{r.derived.get(f'{name}.damping_ratio', (math.nan, 0))[0]:.3g})")
+
+    return Proposal(
+        "rotary_oscillator", (name,), model + RotaryOscillator(name, axes=axes),
+        tuple(measurement),
+        {f"{name}.inertia": inertia, f"{name}.stiffness": inertia * w0**2,
+         f"{name}.damping": 2 * ROTARY_PROBE_DAMPING * inertia * w0},
+        plausible=plausible_rotary, describe=describe_rotary)
+
+
 def _rotor_proposal(model: Model, measurement, current: FitResult,
-                    evidence: Evidence) -> Proposal | None:
+                    evidence: Evidence, scan=None) -> Proposal | None:
     from analogs import Rotor, SpinningRig
 
     from ..data.models import ROTOR_AXIS
@@ -199,7 +321,6 @@ def _rotor_proposal(model: Model, measurement, current: FitResult,
         return None
     name = next(f"r{k}" for k in range(1, 99)
                 if not any(c.name == f"r{k}" for c in model.components))
-    scan = scan_rotor(current)
     if scan is None:
         return None
     inertia, damping, explained = scan
@@ -242,8 +363,11 @@ def propose(model: Model, measurement: tuple[MeasurementModel, ...], current: Fi
     if len(current.channels[0] if current.channels else ()) > 1:
         # multi-channel (spinning rig): the lateral candidates read the carriage input and
         # the lateral force; here only what the rig's rotation can reveal
-        rotor = _rotor_proposal(model, measurement, current, evidence)
-        return [rotor] if rotor is not None else []
+        scan = scan_rotor(current)
+        rotor = _rotor_proposal(model, measurement, current, evidence, scan)
+        rotary = _rotary_proposal(model, measurement, current, evidence,
+                                  scan[2] if scan is not None else 0.0)
+        return [p for p in (rotor, rotary) if p is not None]
     pend = _pendulums(model)
     p1 = pend[0] if pend else None
     m1 = values.get(f"{p1}.mass", 1.0) if p1 else 1.0

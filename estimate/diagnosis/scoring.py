@@ -25,7 +25,9 @@ def holdout_weights(n: int, *, blocks: int = 10, held: Sequence[int] = (1, 4, 7)
 
 
 def heldout(res: FitResult) -> tuple[float, float]:
-    """Held-out RMS residual (N, or channel scales) and held-out chi-square.
+    """Held-out RMS residual (N, or channel scales) and held-out chi-square (residuals in
+    units of the noise: the estimated noise levels, or for several channels fitted without
+    them, each channel's white-noise level from its spectrum).
 
     With an estimated input, the carriage motion in held-out blocks rests on the
     displacement alone, whose noise makes acceleration noise above the signal band: the
@@ -55,11 +57,30 @@ def heldout(res: FitResult) -> tuple[float, float]:
                                      for j in range(r.shape[1])])
                 factor = min(2 * noise.band_hz / fs, 1.0)
                 cost = cost * np.sqrt(factor)
+        elif len(chans) > 1:
+            # several channels scaled by their RMS (the spinning rig): the chi-square in
+            # units of each channel's white noise, so that its threshold means the same
+            # on every record
+            cost = _channel_noise(res, i, chans)
         r = r[out]
         num += float(np.sum((r / report) ** 2))
         chi2 += float(np.sum((r / cost) ** 2)) * factor
         cnt += r.size
     return (math.sqrt(num / cnt), chi2) if cnt else (res.rms_residual, math.nan)
+
+
+def _channel_noise(res: FitResult, i: int, chans: Sequence[str]) -> np.ndarray:
+    """White-noise level of each measured channel of case ``i`` (N, N m), read from its
+    spectrum above the rig's mechanics (:func:`estimate.fitting.carriage.record_noise`:
+    tones removed, above 3 times the fastest rig rate and at least 12 Hz)."""
+    from ..fitting.carriage import record_noise
+
+    case = res.problem.experiments[i].case
+    spin = case.spin
+    top = 0.0 if spin is None else max(abs(spin.rate), abs(2 * math.pi * spin.nutation_frequency),
+                                       abs(spin.rate - 2 * math.pi * spin.nutation_frequency))
+    return np.array([record_noise(case.time, case.channels[c], top / (2 * math.pi)).force_noise
+                     for c in chans])
 
 
 def _weighted(res: FitResult) -> bool:

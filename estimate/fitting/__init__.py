@@ -1,11 +1,12 @@
 """Parameter estimation: the problem, its transcription, the NLP solved by IPOPT, the result
 with uncertainties and identifiability, profile-likelihood intervals and fit plots."""
 
+from .measurement import ChannelOffsets
 from .nlp import Hessian, fit
 from .problem import FitProblem
 from .profile import profile_interval
 from .result import FitResult
 from .transcription import Collocation, MultipleShooting
 
-__all__ = ["Collocation", "FitProblem", "FitResult", "Hessian", "MultipleShooting", "fit",
+__all__ = ["ChannelOffsets", "Collocation", "FitProblem", "FitResult", "Hessian", "MultipleShooting", "fit",
            "profile_interval"]

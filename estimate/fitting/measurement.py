@@ -16,7 +16,7 @@ from scipy.interpolate import CubicSpline
 
 from analogs import Param
 
-__all__ = ["MeasurementModel", "RigFriction", "SensorDelay", "SensorOffset"]
+__all__ = ["ChannelOffsets", "MeasurementModel", "RigFriction", "SensorDelay", "SensorOffset"]
 
 
 class MeasurementModel:
@@ -24,11 +24,18 @@ class MeasurementModel:
 
     #: Parameters by full dotted name.
     parameters: Mapping[str, Param] = {}
+    #: The measured channels the term adds to, in its columns' order; ``None``: the one
+    #: channel of a lateral case.
+    channels: tuple[str, ...] | None = None
+    #: Whether the parameters are estimated separately for every case (a property of each
+    #: record, such as a transducer's zero) rather than shared.
+    per_case: bool = False
 
     def term(self, u: ca.DM, inputs: tuple[str, ...], p: Mapping[str, ca.MX],
              t: np.ndarray) -> ca.MX | None:
         """Force (N) added to the simulated force at the sample times ``t`` (s), given the
-        inputs ``u`` there, or ``None``."""
+        inputs ``u`` there, or ``None``; with :attr:`channels`, a ``samples x channels``
+        matrix added to those channels."""
         return None
 
     def measured(self, t: np.ndarray, force: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
@@ -73,6 +80,50 @@ class SensorOffset(MeasurementModel):
     def term(self, u, inputs, p, t):
         t = np.asarray(t, float)
         return p["rig.force_offset"] + p["rig.force_drift"] * ca.DM(t - t[0])
+
+
+_CHANNEL_UNITS = {"force": "N", "torque": "N m"}
+
+
+@dataclass(frozen=True)
+class ChannelOffsets(MeasurementModel):
+    """A multi-axis transducer whose every channel has its own zero error and drifts
+    linearly over the record: ``y_rec,c(t) = y_c(t) + offset_c + drift_c (t - t0)``, with
+    ``t0`` the record's first sample.
+
+    Parameters ``rig.<channel>_offset`` (N or N m) and ``rig.<channel>_drift`` (N/s or
+    N m/s) for every channel in ``channels``, estimated for each case separately (a zero and
+    a drift belong to one record). ``channels=None`` stands for every channel the cases
+    measure (:meth:`estimate.fitting.FitProblem.build` fills it in); ``drift=False``
+    estimates the offsets only.
+
+    Examples
+    --------
+    >>> prob = FitProblem.build(case, model, measurement=(ChannelOffsets(),))  # doctest: +SKIP
+    """
+
+    channels: tuple[str, ...] | None = None
+    drift: bool = True
+
+    per_case = True
+
+    @property
+    def parameters(self) -> dict[str, Param]:  # type: ignore[override]
+        out = {}
+        for c in self.channels or ():
+            unit = _CHANNEL_UNITS[c.split("_")[0]]
+            out[f"rig.{c}_offset"] = Param(unit, 0.0, description=f"{c} transducer offset")
+            if self.drift:
+                out[f"rig.{c}_drift"] = Param(f"{unit}/s", 0.0,
+                                              description=f"{c} transducer drift rate")
+        return out
+
+    def term(self, u, inputs, p, t):
+        t = np.asarray(t, float)
+        dt = ca.DM(t - t[0])
+        cols = [p[f"rig.{c}_offset"] + (p[f"rig.{c}_drift"] * dt if self.drift else 0 * dt)
+                for c in self.channels or ()]
+        return ca.horzcat(*cols)
 
 
 @dataclass(frozen=True)

@@ -154,6 +154,8 @@ class FitProblem:
         hold, initial_user, bounds_user = dict(hold or {}), dict(initial or {}), dict(bounds or {})
         # each case on its own rig (a measured and a crank case share the physical parameters)
         exps = tuple(experiment(c, model_for_case(model, c)) for c in cases)
+        measurement = _resolve_channels(tuple(measurement), exps)
+        per_case_names = {n for mm in measurement if mm.per_case for n in mm.parameters}
         params = {p.name: p for e in exps for p in e.derived.parameters}
         for mm in measurement:
             params |= {n: _as_parameter(n, spec) for n, spec in mm.parameters.items()}
@@ -205,8 +207,12 @@ class FitProblem:
             lo, hi = bounds_user.get(n, (lo, hi))
             x0 = min(max(start[n], lo), hi)
             scale = nominal_scale(n, x0, start, g)
-            targets = ([i for i, e in enumerate(exps) if n in e.derived.parameter_names]
-                       if n in PER_CASE else [None])
+            if n in per_case_names:
+                targets = list(range(len(exps)))
+            elif n in PER_CASE:
+                targets = [i for i, e in enumerate(exps) if n in e.derived.parameter_names]
+            else:
+                targets = [None]
             for i in targets:
                 label = n if i is None else f"{cases[i].test.id}:{n}"
                 est.append(Estimated(label, n, i, p.unit, x0, lo, hi, scale))
@@ -229,9 +235,11 @@ class FitProblem:
         if missing_ch:
             raise InputError(f"cases {', '.join(missing_ch)} measure none of the model's outputs "
                              + ", ".join(exps[0].derived.measured))
-        if measurement and any(len(e.channels) > 1 for e in exps):
-            raise InputError("measurement models (friction, sensor delay) apply to the lateral "
-                             "force only; remove `measurement` for multi-channel cases")
+        single = [type(mm).__name__ for mm in measurement if mm.channels is None]
+        if single and any(len(e.channels) > 1 for e in exps):
+            raise InputError(f"measurement models {', '.join(single)} apply to the lateral "
+                             "force only; remove them for multi-channel cases (their channels' "
+                             "offsets and drifts: `ChannelOffsets()`)")
         w = tuple(weights) if weights is not None else tuple(None for _ in exps)
         if len(w) != len(exps):
             raise InputError(f"weights: expected one entry per case ({len(exps)}), got {len(w)}")
@@ -315,6 +323,32 @@ class FitProblem:
         bad = [e.name for e in self.estimated if not math.isfinite(e.initial)]
         if bad:
             raise InputError(f"initial values are not finite: {', '.join(bad)}")
+
+
+def _resolve_channels(measurement: tuple, exps: Sequence[Experiment]) -> tuple:
+    """Measurement models with their channels filled in: a multi-channel model declared
+    with ``channels=None`` (:class:`~estimate.fitting.measurement.ChannelOffsets`) takes the
+    channels the cases measure, which must then be the same in every case; one with
+    channels names only channels every case measures, in the model's order."""
+    from .measurement import ChannelOffsets
+
+    out = []
+    for mm in measurement:
+        if isinstance(mm, ChannelOffsets):
+            measured = {e.channels for e in exps}
+            if mm.channels is None:
+                if len(measured) > 1:
+                    raise InputError("ChannelOffsets(): the cases measure different channels ("
+                                     + "; ".join(", ".join(c) for c in sorted(measured))
+                                     + "); name them: `ChannelOffsets(channels=(...))`")
+                mm = replace(mm, channels=exps[0].channels)
+            for e in exps:
+                if tuple(mm.channels) != e.channels:
+                    raise InputError(f"ChannelOffsets: channels {', '.join(mm.channels)} are not "
+                                     f"the channels case {e.case.test.id} fits, in order: "
+                                     f"{', '.join(e.channels)}")
+        out.append(mm)
+    return tuple(out)
 
 
 def _as_parameter(name: str, spec):

@@ -1,11 +1,14 @@
 """Six-channel estimation on the spinning rig against synthetic data from the independent
 reference simulator (``tests/reference_spinning.py``: hand-written equations, SciPy)."""
 
+from dataclasses import replace
+
 import numpy as np
 import pytest
 import reference_spinning as rs
 from synthetic_cases import make_spinning_case
 
+from analogs.errors import InputError
 from estimate import FitProblem, fit, model_from_spec
 
 #: Issue 7 acceptance: rotor inertia and damping within 10 %, pendulum within 5 %, on
@@ -79,3 +82,70 @@ def test_spinning_model_specs(spinning_case):
     assert rotor.axis == "y"  # tangential: the axis the nutation drives
     with pytest.raises(ValueError, match="a rotor takes no modifiers"):
         model_from_spec("fixed,r1:quadratic", spinning_case)
+
+
+#: Zero errors and drift rates added to a fixed-mass record, per channel (N or N m, per s):
+#: of the order a strain-gauge transducer shows over a test (tenths of a newton).
+OFFSETS = {"force_x": (0.3, -0.02), "force_y": (-0.1, 0.01), "force_z": (0.5, 0.03),
+           "torque_x": (0.01, 1e-3), "torque_y": (-0.02, -2e-3), "torque_z": (5e-3, 5e-4)}
+
+
+@pytest.fixture(scope="module")
+def drifting_case(tmp_path_factory):
+    """A fixed mass spun up over 5 s (the rig's forces change, so an offset is not a mass)
+    recorded by a transducer with the :data:`OFFSETS` added."""
+    rig = rs.Rig(spin_rate=6.0, radius=0.4, height=0.1, nutation_angle=0.06,
+                 nutation_frequency=0.3, dry_mass=2.0, spin_up=5.0)
+    case, _ = make_spinning_case(tmp_path_factory.mktemp("drift"), "D1", rig, fixed_mass=1.5,
+                                 fixed_height=0.05, noise=0.01, seed=5, duration=10.0)
+    dt = case.time - case.time[0]
+    cols = dict(case.columns)
+    for c, (off, rate) in OFFSETS.items():
+        cols[c] = cols[c] + off + rate * dt
+    return replace(case, columns=cols)
+
+
+def _fixed_mass_problem(case, **kw):
+    return FitProblem.build(case, model_from_spec("fixed", case),
+                            hold={"fixed.inertia": 0.0, "fixed.axial_inertia": 0.0}, **kw)
+
+
+def test_channel_offsets_and_drifts_are_estimated_per_case(drifting_case):
+    from estimate import ChannelOffsets
+
+    prob = _fixed_mass_problem(drifting_case, measurement=(ChannelOffsets(),))
+    units = dict(zip(prob.names, (e.unit for e in prob.estimated)))
+    assert units["D1:rig.force_z_offset"] == "N" and units["D1:rig.torque_y_drift"] == "N m/s"
+    assert len([n for n in prob.names if n.startswith("D1:rig.")]) == 12
+    res = fit(prob, progress=False)
+    assert res.converged, res.status
+    # the truth within 3 stated standard errors (the noise is white and the model exact)
+    truth = {"fixed.mass": 1.5, "fixed.height": 0.05}
+    truth |= {f"D1:rig.{c}_offset": v[0] for c, v in OFFSETS.items()}
+    truth |= {f"D1:rig.{c}_drift": v[1] for c, v in OFFSETS.items()}
+    for name, value in truth.items():
+        se = res.stderr[res.names.index(name)]
+        assert abs(res.value(name) - value) <= 3 * se, (name, res.value(name), value, se)
+    # without them the offsets stay in the residual, far above the 1 % noise
+    plain = fit(_fixed_mass_problem(drifting_case), progress=False)
+    assert plain.residual_variance > 100 * res.residual_variance
+    # offsets only: the drift stays unexplained
+    only = _fixed_mass_problem(drifting_case, measurement=(ChannelOffsets(drift=False),))
+    assert not any(n.endswith("_drift") for n in only.names)
+
+
+def test_channel_offsets_must_name_the_fitted_channels(spinning_case, drifting_case):
+    from estimate import ChannelOffsets
+    from estimate.fitting.measurement import SensorOffset
+
+    with pytest.raises(InputError, match="not the channels case S1 fits"):
+        FitProblem.build(spinning_case, model_from_spec("fixed,p1", spinning_case),
+                         measurement=(ChannelOffsets(channels=("force_x",)),))
+    with pytest.raises(InputError, match="SensorOffset apply to the lateral force only"):
+        FitProblem.build(spinning_case, model_from_spec("fixed,p1", spinning_case),
+                         measurement=(SensorOffset(),))
+    with pytest.raises(InputError, match="measure different channels"):
+        trimmed = replace(drifting_case, columns={
+            k: v for k, v in drifting_case.columns.items() if k != "torque_z"})
+        FitProblem.build([spinning_case, trimmed], model_from_spec("fixed,p1", spinning_case),
+                         measurement=(ChannelOffsets(),))
