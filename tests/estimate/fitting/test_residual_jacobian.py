@@ -54,10 +54,12 @@ def test_assembled_residual_jacobian_equals_automatic_differentiation(cases, var
     assert np.max(np.abs(assembled - automatic)) <= 1e-12 * np.max(np.abs(automatic))
 
 
-@pytest.mark.parametrize("steady", [False, True])
-def test_six_channel_residual_jacobian_equals_automatic_differentiation(tmp_path, steady):
+@pytest.mark.parametrize("steady, offsets", [(False, False), (True, False), (False, True)])
+def test_six_channel_residual_jacobian_equals_automatic_differentiation(tmp_path, steady,
+                                                                        offsets):
     """The spinning rig: six channels of different units (scaled per channel), a pendulum
-    and a rotor, from rest or from the steady relative equilibrium."""
+    and a rotor, from rest or from the steady relative equilibrium, with or without every
+    channel's offset and drift estimated."""
     import reference_spinning as rs
     from synthetic_cases import make_spinning_case
 
@@ -67,7 +69,10 @@ def test_six_channel_residual_jacobian_equals_automatic_differentiation(tmp_path
         tmp_path, "S", rig, pendulum=rs.SphericalPendulum(1.25, 0.062, 0.035, damping=5e-4),
         rotor=rs.Rotor(0.01, 0.04, axis="y"), fixed_mass=1.5, fixed_height=0.05, noise=0.01,
         duration=2.0, steady=steady, tank_radius=0.1016)
-    problem = FitProblem.build(case, model_from_spec("fixed,p1,r1", case))
+    from estimate.fitting.measurement import ChannelOffsets
+
+    problem = FitProblem.build(case, model_from_spec("fixed,p1,r1", case),
+                               measurement=(ChannelOffsets(),) if offsets else ())
     kind = "steady" if steady else "rest"
     nlp, terms = _setup(problem, MultipleShooting(), "squared", [kind], True, False, None)
     assert len(problem.channels(0)) == 6 and terms[0].jacobian is not None
