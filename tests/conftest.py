@@ -21,6 +21,12 @@ import estimate  # noqa: E402,F401
 sys.path[:] = _path
 if str(_TESTS) not in sys.path:
     sys.path.insert(0, str(_TESTS))
+# child processes (a Dask LocalCluster's workers) start from this path without the trick
+# above: with the folder holding the project's packages on it, a regular package wins over
+# the namespace portions in tests/ wherever they stand on the path
+_PACKAGES = str(Path(estimate.__file__).resolve().parents[1])
+if _PACKAGES not in sys.path:
+    sys.path.append(_PACKAGES)
 
 import pytest
 
