@@ -22,6 +22,7 @@ The fits and the diagnosis take minutes: they are marked slow (``pytest -m slow`
 
 import json
 import math
+import re
 
 import numpy as np
 import pytest
@@ -143,11 +144,12 @@ def test_b_steady_start_with_the_rotor_fits(record_b):
 
 
 @pytest.mark.slow
-def test_b_fits_from_the_command_line_with_honest_bounds(record_b, tmp_path):
+def test_b_fits_from_the_command_line_with_honest_bounds(record_b, tmp_path, capsys):
     case, _ = record_b
     out = tmp_path / "fit.json"
     assert main(["fit", str(case.path), "--model", "fixed,p1:nospring,r1",
                  "--json", str(out)]) == 0
+    text = capsys.readouterr().out
     data = json.loads(out.read_text(), parse_constant=lambda c: pytest.fail(f"JSON has {c}"))
     assert data["initial_state"] == {"B1": "steady"}
     assert set(data["initial_states"]["B1"]) == {"p1.alpha", "p1.beta", "r1.psi",
@@ -158,6 +160,14 @@ def test_b_fits_from_the_command_line_with_honest_bounds(record_b, tmp_path):
     assert np.all(np.abs(corr) <= 1.0)
     assert all(v["stderr"] is None or v["stderr"] > 0 for v in p.values() if v["estimated"])
     assert all(("at_bound" in v) == (v["stderr"] is None) for v in p.values() if v["estimated"])
+    # the fixed mass's inertias are 0 in the truth: an estimate at its 0 bound is reported as
+    # such, with a one-sided limit and no Wald interval
+    at_zero = [n for n in ("fixed.inertia", "fixed.axial_inertia")
+               if p[n].get("at_bound") == "lower"]
+    assert at_zero, {n: p[n] for n in ("fixed.inertia", "fixed.axial_inertia")}
+    for n in at_zero:
+        assert n not in data["covariance"]["parameters"]
+        assert re.search(rf"{re.escape(n)} .* at its lower bound 0 \(one-sided 95 %: <= ", text), text
 
 
 @pytest.mark.slow
