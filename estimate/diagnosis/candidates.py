@@ -174,12 +174,7 @@ def scan_rotor(current: FitResult, *, case: int = 0, n: int = 16,
         return None
     exp = problem.experiments[case]
     t = np.asarray(exp.case.time, float)
-    chans = current.channels[case]
-    scales = np.array([current.channel_scales[case][c] for c in chans])
-    w = np.tile(current.weights[case] > 0, len(chans))
-    r = (current.residuals[case] / scales).ravel(order="F")[w]
-    offset = sum(int(np.size(current.residuals[k])) for k in range(case))
-    J = current.sensitivity[offset:offset + r.size + int(np.count_nonzero(~w))][w]
+    r, J, chans, scales, w = _spin_residual(current, case)
     probe = derive(Model((rig,)) + Rotor("q", axis=ROTOR_AXIS))
     values = {k: v for k, v in problem.case_values(case, current.values).items()
               if k.startswith("rig.")}

@@ -1,11 +1,13 @@
-"""SciPy sparse matrices as CasADi matrices."""
+"""Sparse CasADi matrices: from SciPy matrices, and scattered from the outputs of mapped
+per-interval functions."""
 
 from __future__ import annotations
 
 import casadi as ca
+import numpy as np
 import scipy.sparse as sps
 
-__all__ = ["sparse_dm"]
+__all__ = ["sparse_dm", "scatter", "affine_parameters"]
 
 
 def sparse_dm(A: sps.spmatrix) -> ca.DM:
@@ -15,3 +17,20 @@ def sparse_dm(A: sps.spmatrix) -> ca.DM:
     C.sort_indices()
     sp = ca.Sparsity(C.shape[0], C.shape[1], C.indptr.tolist(), C.indices.tolist())
     return ca.DM(sp, C.data)
+
+
+def scatter(values: ca.MX, shape: tuple[int, int], rows: np.ndarray, cols: np.ndarray,
+            src: np.ndarray) -> ca.MX:
+    """Sparse ``shape`` matrix with entry ``(rows[i], cols[i]) = values[src[i]]``."""
+    sp, mapping = ca.Sparsity.triplet(shape[0], shape[1], np.asarray(rows).tolist(),
+                                      np.asarray(cols).tolist(), True)
+    nz = np.empty(sp.nnz(), dtype=int)
+    nz[np.asarray(mapping, dtype=int)] = src
+    return ca.MX(sp, values[nz.tolist()])
+
+
+def affine_parameters(p: ca.MX, theta: ca.MX) -> tuple[ca.DM, ca.DM]:
+    """``(p0, S)`` with ``p = p0 + S theta`` for a parameter vector affine in ``theta``."""
+    S = ca.evalf(ca.jacobian(p, theta))
+    p0 = ca.evalf(ca.substitute(p, theta, ca.DM.zeros(theta.numel())))
+    return p0, S

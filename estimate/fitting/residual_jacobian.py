@@ -16,6 +16,8 @@ import numpy as np
 
 from derive import OUTPUT_NAMES, DerivedModel
 
+from ._sparse import affine_parameters, scatter
+
 __all__ = ["output_jacobian", "force_residual_jacobian"]
 
 
@@ -45,15 +47,6 @@ def output_jacobian(dm: DerivedModel, channels: tuple[str, ...], ntheta: int,
     return dm._memo[key]
 
 
-def _scatter(values: ca.MX, shape: tuple[int, int], rows: np.ndarray, cols: np.ndarray,
-             src: np.ndarray) -> ca.MX:
-    """Sparse ``shape`` matrix with entry ``(rows[i], cols[i]) = values[src[i]]``."""
-    sp, mapping = ca.Sparsity.triplet(shape[0], shape[1], rows.tolist(), cols.tolist(), True)
-    nz = np.empty(sp.nnz(), dtype=int)
-    nz[np.asarray(mapping, dtype=int)] = src
-    return ca.MX(sp, values[nz.tolist()])
-
-
 def force_residual_jacobian(dm: DerivedModel, channels: tuple[str, ...], X: ca.MX,
                             Ug: ca.MX | ca.DM, p: ca.MX, theta: ca.MX, t: np.ndarray,
                             factor: np.ndarray, fixed_start: bool, compiled: bool,
@@ -69,8 +62,7 @@ def force_residual_jacobian(dm: DerivedModel, channels: tuple[str, ...], X: ca.M
     """
     n, nx, nu, nch = t.size, dm.nx, dm.nu, len(channels)
     ntheta = theta.numel()
-    S = ca.evalf(ca.jacobian(p, theta))
-    p0 = ca.evalf(ca.substitute(p, theta, ca.DM.zeros(ntheta)))
+    p0, S = affine_parameters(p, theta)
     fn = output_jacobian(dm, channels, ntheta, compiled)
     Jx, Ju, Jt = fn.map(n)(X, Ug, p0, ca.vec(S), theta, ca.DM(t).T)
     k = np.arange(n)
@@ -93,14 +85,14 @@ def force_residual_jacobian(dm: DerivedModel, channels: tuple[str, ...], X: ca.M
         return ca.vec(values) * ca.DM(factor[(v % nch) * n + v // (nch * width)])
 
     rows, cols, src = entries(ntheta, lambda K, J: J)
-    J_theta = _scatter(scaled(Jt, ntheta), (nch * n, ntheta), rows, cols, src)
+    J_theta = scatter(scaled(Jt, ntheta), (nch * n, ntheta), rows, cols, src)
     off = -1 if fixed_start else 0
     nvar = (n + off) * nx
     rows, cols, src = entries(nx, lambda K, J: (K + off) * nx + J, keep=k + off >= 0)
-    J_states = _scatter(scaled(Jx, nx), (nch * n, nvar), rows, cols, src)
+    J_states = scatter(scaled(Jx, nx), (nch * n, nvar), rows, cols, src)
     J_c = None
     if A_grid is not None:
         rows, cols, src = entries(nu, lambda K, J: K * nu + J)
-        J_u = _scatter(scaled(Ju, nu), (nch * n, nu * n), rows, cols, src)
+        J_u = scatter(scaled(Ju, nu), (nch * n, nu * n), rows, cols, src)
         J_c = ca.mtimes(J_u, A_grid)
     return J_theta, J_states, J_c

@@ -22,6 +22,8 @@ import numpy as np
 from derive import DerivedModel, Excitation, rk4_step
 from derive.simulate import interval_inputs
 
+from ._sparse import affine_parameters, scatter
+
 __all__ = ["Transcription", "MultipleShooting", "Collocation", "Block", "InputCoefficients"]
 
 
@@ -106,8 +108,7 @@ class MultipleShooting(Transcription):
             xn = step.map(n - 1)(X[:, :-1], U, p, tk, hk)
             return Block(ca.vec(W), np.asarray(w0).ravel(order="F"), ca.vec(X[:, 1:] - xn), X)
         # p = p0 + S theta (affine); per-interval value and Jacobians in one function
-        S = ca.evalf(ca.jacobian(p, theta))
-        p0 = ca.evalf(ca.substitute(p, theta, ca.DM.zeros(theta.numel())))
+        p0, S = affine_parameters(p, theta)
         fn = _step_jacobian(dm, self.substeps, theta.numel(), compiled)
         xn, JxT, JtT, JuT = fn.map(n - 1)(X[:, :-1], U, p0, ca.vec(S), theta, tk, hk)
         # g stays differentiable by CasADi (interpreted step); the possibly compiled
@@ -169,16 +170,10 @@ def _bidiagonal(nx: int, n: int, negJ: ca.MX, *, fixed_start: bool) -> ca.MX:
     r_j = (kk[:, None] * nx + ii.ravel()[None, :]).ravel()
     c_j = ((kk[:, None] + offset) * nx + cc.ravel()[None, :]).ravel()
     s_j = (kk[:, None] * nx * nx + (ii * nx + cc).ravel()[None, :]).ravel()
-    rows = np.concatenate([r_id, r_j])
-    cols = np.concatenate([c_id, c_j])
-    src = np.concatenate([np.full(r_id.size, -1), s_j])
-    sp, mapping = ca.Sparsity.triplet((n - 1) * nx, nvar, rows.tolist(), cols.tolist(), True)
-    mapping = np.asarray(mapping, dtype=int)
-    nz_src = np.empty(sp.nnz(), dtype=int)
-    nz_src[mapping] = src
-    values = ca.vertcat(ca.vec(negJ), ca.MX(1.0))  # index -1 -> the constant 1
-    nz_src[nz_src < 0] = values.numel() - 1
-    return ca.MX(sp, values[nz_src.tolist()])
+    values = ca.vertcat(ca.vec(negJ), ca.MX(1.0))  # the last entry: the constant 1
+    src = np.concatenate([np.full(r_id.size, values.numel() - 1), s_j])
+    return scatter(values, ((n - 1) * nx, nvar), np.concatenate([r_id, r_j]),
+                   np.concatenate([c_id, c_j]), src)
 
 
 def _block_diagonal(nx: int, nU: int, blocks: int, negJuT: ca.MX) -> ca.MX:
@@ -188,11 +183,7 @@ def _block_diagonal(nx: int, nU: int, blocks: int, negJuT: ca.MX) -> ca.MX:
     rows = (k * nx + i).ravel()
     cols = (k * nU + j).ravel()
     src = ((k * nx + i) * nU + j).ravel()  # column-major index into negJuT
-    sp, mapping = ca.Sparsity.triplet(nx * blocks, nU * blocks, rows.tolist(), cols.tolist(),
-                                      True)
-    nz = np.empty(sp.nnz(), dtype=int)
-    nz[np.asarray(mapping, dtype=int)] = src
-    return ca.MX(sp, ca.vec(negJuT)[nz.tolist()])
+    return scatter(ca.vec(negJuT), (nx * blocks, nU * blocks), rows, cols, src)
 
 
 @dataclass(frozen=True)
