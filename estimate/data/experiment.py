@@ -2,8 +2,9 @@
 
 from __future__ import annotations
 
-from collections.abc import Mapping
-from dataclasses import dataclass
+from collections.abc import Callable, Mapping
+from dataclasses import dataclass, field, replace
+from functools import cached_property
 
 import numpy as np
 
@@ -23,13 +24,25 @@ class Experiment:
     """A case with its derived model and the excitation taken from its data.
 
     ``fixed`` holds the parameter values the case file sets (dry mass, gravity, crank).
+    ``make_excitation`` builds :attr:`excitation` when it is first asked for (a fit that
+    estimates the carriage motion never needs the filtered one).
     """
 
     case: Case
     model: Model
     derived: DerivedModel
-    excitation: Excitation | None
+    make_excitation: Callable[[], Excitation | None] = field(repr=False)
     fixed: Mapping[str, float]
+
+    @cached_property
+    def excitation(self) -> Excitation | None:
+        """The rig's inputs from the case's data, ``None`` when the model takes none from
+        it (a crank drive, a spinning rig at constant rates)."""
+        return self.make_excitation()
+
+    def with_excitation(self, excitation: Excitation | None) -> "Experiment":
+        """This experiment driven by ``excitation`` instead (e.g. an exact carriage motion)."""
+        return replace(self, make_excitation=lambda: excitation)
 
     def simulate(self, params: Mapping[str, float], *, x0: Mapping[str, float] | None = None,
                  **options) -> Simulation:
@@ -92,12 +105,18 @@ def experiment(case: Case, model: Model) -> Experiment:
     if case.test.rig == "lateral" and case.test.excitation == "measured":
         if case.displacement is None:
             raise InputError(f"{case.path}: excitation = 'measured' needs a displacement column")
-        x, xd, xdd = displacement_derivatives(case.time, case.displacement)
-        exc: Excitation | None = Sampled(case.time, np.vstack([x, xd, xdd]))
+
+        def exc() -> Excitation | None:
+            x, xd, xdd = displacement_derivatives(case.time, case.displacement)
+            return Sampled(case.time, np.vstack([x, xd, xdd]))
     elif case.spin is not None and case.spin.motion == "input":
         from .spin import spin_excitation
 
-        exc = spin_excitation(case)
+        spin = spin_excitation(case)  # built now: its errors belong to loading the case
+
+        def exc() -> Excitation | None:
+            return spin
     else:
-        exc = None
+        def exc() -> Excitation | None:
+            return None
     return Experiment(case, model, dm, exc, rig_values(case))

@@ -12,11 +12,12 @@ __all__ = ["sparse_dm", "scatter", "affine_parameters"]
 
 def sparse_dm(A: sps.spmatrix) -> ca.DM:
     """``A`` as a CasADi DM with the same sparsity, built from its CSC arrays (several
-    times faster than CasADi's generic conversion of a SciPy matrix)."""
+    times faster than CasADi's generic conversion of a SciPy matrix; Python lists convert
+    faster than NumPy arrays)."""
     C = sps.csc_matrix(A)
     C.sort_indices()
     sp = ca.Sparsity(C.shape[0], C.shape[1], C.indptr.tolist(), C.indices.tolist())
-    return ca.DM(sp, C.data)
+    return ca.DM(sp, C.data.tolist())
 
 
 def scatter(values: ca.MX, shape: tuple[int, int], rows: np.ndarray, cols: np.ndarray,

@@ -7,7 +7,7 @@ states), the covariance of the parameters is ``s^2`` times their block of the in
 the KKT matrix ``[[J_e^T J_e, J_g^T], [J_g, 0]]``: the inverse of the information reduced to
 the constraint manifold, with states eliminated and nuisance variables (carriage motion,
 free initial states) marginalised. ``s^2 = |e|^2 / (n - k)`` is the residual variance (``k``
-counts every estimated quantity). One sparse LDL^T factorisation, a solve per parameter.
+counts every estimated quantity). One sparse LU factorisation, a solve per parameter.
 
 The residual sensitivity to the parameters alone (states follow through the constraints,
 nuisance variables held) is kept for the identifiability check and the diagnosis.
@@ -122,8 +122,6 @@ def _inverse(S: np.ndarray) -> tuple[np.ndarray, bool]:
 #: a weak prior that is nothing for what the data determine, and a huge finite variance
 #: for a direction they do not.
 _PRIOR_INFORMATION = 1e-6
-#: Refinement steps allowed before the pivoted LU takes over.
-_REFINEMENTS = 8
 
 
 class ReducedKKT:
@@ -151,7 +149,7 @@ class ReducedKKT:
         else:
             K0 = sps.bmat([[Hrr, Gr.T], [Gr, None]], format="csc") if self.ng else Hrr
             self.B = sps.vstack([Hrt, Gt]).toarray() if self.ng else Hrt.toarray()
-            self._solve = _factorise(K0, self.n_primal)
+            self._solve = _factorise(K0)
             self.Y = self._solve(self.B)
         S = self.Htt - self.B.T @ self.Y
         self.information = 0.5 * (S + S.T)
@@ -188,43 +186,11 @@ def parameter_information(Je: sps.spmatrix, Jg: sps.spmatrix, ntheta: int) -> np
     return ReducedKKT(Je, Jg, ntheta).information
 
 
-def _factorise(K: sps.csc_matrix, n_primal: int):
-    """A function ``B -> K^-1 B`` for a KKT matrix ``K`` (``n_primal`` primal rows first).
-
-    ``K`` is made quasi-definite by ``+delta I`` and ``-eps I`` diagonal blocks far below its
-    entries (1e-15 relative), which CasADi's sparse LDL^T factorises without pivoting;
-    iterative refinement on ``K`` itself removes their effect. With the parameters held, the
-    states and nuisance variables are well determined, so refinement converges; if it does
-    not, SuperLU's pivoted LU solves the system."""
-    import casadi as ca
-
-    from ._sparse import sparse_dm
-
-    n = K.shape[0]
-    scale = float(abs(K).max()) or 1.0
-    reg = sps.diags(np.r_[np.full(n_primal, 1e-15 * scale), np.full(n - n_primal, -1e-15)])
-    Kr = sparse_dm((K + reg).tocsc())
-    try:
-        solver = ca.Linsol("kkt", "ldl", Kr.sparsity())
-    except RuntimeError:
-        solver = None
-    lu: list = []
-
-    def solve(B: np.ndarray) -> np.ndarray:
-        if solver is not None:
-            try:
-                X = np.asarray(solver.solve(Kr, ca.DM(B)))
-                for _ in range(_REFINEMENTS):
-                    dX = np.asarray(solver.solve(Kr, ca.DM(B - K @ X)))
-                    X = X + dX
-                    if not np.all(np.isfinite(X)):
-                        break
-                    if np.max(np.abs(dX)) <= 1e-10 * max(np.max(np.abs(X)), 1e-300):
-                        return X
-            except RuntimeError:
-                pass
-        if not lu:
-            lu.append(spla.splu(K))
-        return lu[0].solve(B)
-
-    return solve
+def _factorise(K: sps.csc_matrix):
+    """A function ``B -> K^-1 B`` for a KKT matrix ``K``:
+    SuperLU's LU with partial pivoting, columns ordered by COLAMD. (Measured against
+    CasADi's LDL^T of a regularised ``K`` with iterative refinement: 0.08 vs 0.12 s for one
+    pendulum, 0.24 vs 0.59 s for two, 3001 samples each: the refinement on the saddle point
+    often did not converge.)"""
+    lu = spla.splu(sps.csc_matrix(K), permc_spec="COLAMD")
+    return lu.solve

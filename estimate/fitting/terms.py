@@ -112,7 +112,6 @@ def case_terms(problem: FitProblem, i: int, theta_s: ca.MX, transcription: Trans
     p_i = _parameter_column(dm, problem.fixed[i], theta_s, problem, i)
     carriage = problem.carriage[i] if problem.carriage else None
     coefficients = None
-    excitation = exp.excitation
     if carriage is not None:
         if dm.inputs != _CARRIAGE_INPUTS:
             raise InputError(f"an estimated carriage motion drives the inputs "
@@ -129,6 +128,7 @@ def case_terms(problem: FitProblem, i: int, theta_s: ca.MX, transcription: Trans
         excitation = Sampled(t, carriage.values(coef0, t))
         coef = c
     else:
+        excitation = exp.excitation
         U = ca.DM(transcription.inputs(excitation, t, dm.nu))
         Ug = ca.DM(excitation.values(t) if dm.nu else np.zeros((0, n)))
         coef, coef0 = ca.MX(0, 1), np.zeros(0)

@@ -57,17 +57,27 @@ def _sine_fit(t: NDArray[np.float64], y: NDArray[np.float64], f: float, harmonic
 def _sine_costs(t: NDArray[np.float64], y: NDArray[np.float64], freqs: NDArray[np.float64]
                 ) -> NDArray[np.float64]:
     """Residual sum of squares of offset + trend + one sinusoid, for every frequency at once
-    (batched normal equations; ``t`` should be centred on the window for conditioning)."""
+    (batched normal equations from sums over the samples, columns normalised; ``t`` should
+    be centred on the window for conditioning)."""
     w = 2.0 * np.pi * np.asarray(freqs, float)[:, None] * t[None, :]
-    ones = np.ones_like(w)
-    A = np.stack([ones, np.broadcast_to(t, w.shape), np.cos(w), np.sin(w)], axis=-1)
-    scale = np.sqrt(np.einsum("gnk,gnk->gk", A, A))
-    A = A / scale[:, None, :]
-    AtA = np.einsum("gnk,gnl->gkl", A, A)
-    Aty = np.einsum("gnk,n->gk", A, y)
-    coef = np.linalg.solve(AtA + 1e-12 * np.eye(4), Aty[..., None])[..., 0]
-    r = y[None, :] - np.einsum("gnk,gk->gn", A, coef)
-    return np.einsum("gn,gn->g", r, r)
+    C, S = np.cos(w), np.sin(w)
+    n, G = t.size, w.shape[0]
+    cc = np.einsum("gn,gn->g", C, C)
+    M = np.empty((G, 4, 4))
+    M[:, 0, 0], M[:, 1, 1] = n, t @ t
+    M[:, 0, 1] = M[:, 1, 0] = t.sum()
+    M[:, 0, 2] = M[:, 2, 0] = C.sum(axis=1)
+    M[:, 0, 3] = M[:, 3, 0] = S.sum(axis=1)
+    M[:, 1, 2] = M[:, 2, 1] = C @ t
+    M[:, 1, 3] = M[:, 3, 1] = S @ t
+    M[:, 2, 3] = M[:, 3, 2] = np.einsum("gn,gn->g", C, S)
+    M[:, 2, 2], M[:, 3, 3] = cc, n - cc
+    b = np.column_stack([np.full(G, y.sum()), np.full(G, t @ y), C @ y, S @ y])
+    d = np.sqrt(np.maximum(np.einsum("gkk->gk", M), 1e-300))
+    Mn = M / (d[:, :, None] * d[:, None, :])
+    bn = b / d
+    coef = np.linalg.solve(Mn + 1e-12 * np.eye(4), bn[..., None])[..., 0]
+    return np.maximum(y @ y - np.einsum("gk,gk->g", bn, coef), 0.0)
 
 
 def _refine_frequency(t: NDArray[np.float64], y: NDArray[np.float64], f0: float,

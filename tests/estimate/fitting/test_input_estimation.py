@@ -55,7 +55,7 @@ def _fit(case, mode="estimated", exact=None):
                                input=mode, force_cutoff_hz=None if exact is not None else "auto")
     if exact is not None:  # test-only: the true carriage motion drives the model
         problem = dataclasses.replace(problem, experiments=tuple(
-            dataclasses.replace(e, excitation=exact) for e in problem.experiments))
+            e.with_excitation(exact) for e in problem.experiments))
     return fit(problem, progress=False)
 
 
