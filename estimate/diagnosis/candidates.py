@@ -164,31 +164,44 @@ def scan_rotor(current: FitResult, *, case: int = 0, n: int = 16,
     import numpy as np
 
     from analogs import Rotor, SpinningRig
-    from derive import RK4, derive, simulate
 
     from ..data.models import ROTOR_AXIS
 
-    problem = current.problem
-    rig = problem.model.rig
+    rig = current.problem.model.rig
     if not isinstance(rig, SpinningRig):
         return None
+    grid = np.geomspace(*rates, n)
+    best = _scan_spin_probe(current, case, Rotor("q", axis=ROTOR_AXIS),
+                            [{"q.damping": float(rate)} for rate in grid])
+    return None if best is None else (best[0], best[0] * float(grid[best[1]]), best[2])
+
+
+def _scan_spin_probe(current: FitResult, case: int, component, trials: list[dict]
+                     ) -> tuple[float, int, float] | None:
+    """Simulate ``component`` (unit inertia ``q.inertia``) alone on the rig motion of
+    ``case`` with each of ``trials``' parameter values and regress the fit's residual on
+    its outputs (:func:`_probe_regression`). Returns ``(inertia, trial index,
+    explained_fraction)`` of the best trial with a positive inertia, or ``None``."""
+    import numpy as np
+
+    from derive import RK4, derive, simulate
+
+    problem = current.problem
     exp = problem.experiments[case]
     t = np.asarray(exp.case.time, float)
     r, J, chans, scales, w = _spin_residual(current, case)
-    probe = derive(Model((rig,)) + Rotor("q", axis=ROTOR_AXIS))
+    probe = derive(Model((problem.model.rig,)) + component)
     values = {k: v for k, v in problem.case_values(case, current.values).items()
               if k.startswith("rig.")}
     values["rig.dry_mass"] = 0.0
     best = None
-    for rate in np.geomspace(*rates, n):
-        sim = simulate(probe, {**values, "q.inertia": 1.0, "q.damping": float(rate)}, t,
-                       exp.excitation, integrator=RK4(), outputs=chans)
+    for k, trial in enumerate(trials):
+        sim = simulate(probe, {**values, "q.inertia": 1.0, **trial}, t, exp.excitation,
+                       integrator=RK4(), outputs=chans)
         y = (sim.outputs / scales[None, :]).ravel(order="F")[w]
         inertia, explained = _probe_regression(y, J, r)
-        if inertia <= 0:
-            continue
-        if best is None or explained > best[2]:
-            best = (inertia, inertia * float(rate), explained)
+        if inertia > 0 and (best is None or explained > best[2]):
+            best = (inertia, k, explained)
     return best
 
 
@@ -228,32 +241,17 @@ def scan_rotary(current: FitResult, *, case: int = 0, n: int = 24,
     import numpy as np
 
     from analogs import RotaryOscillator, SpinningRig
-    from derive import RK4, derive, simulate
 
     problem = current.problem
     rig = problem.model.rig
     spin = problem.experiments[case].case.spin
     if not isinstance(rig, SpinningRig) or spin is None or not spin.rate:
         return None
-    exp = problem.experiments[case]
-    t = np.asarray(exp.case.time, float)
-    r, J, chans, scales, w = _spin_residual(current, case)
-    probe = derive(Model((rig,)) + RotaryOscillator("q", axes=rotary_axes(rig)))
-    values = {k: v for k, v in problem.case_values(case, current.values).items()
-              if k.startswith("rig.")}
-    values["rig.dry_mass"] = 0.0
-    best = None
-    for w0 in abs(spin.rate) * np.geomspace(*ratios, n):
-        sim = simulate(probe, {**values, "q.inertia": 1.0, "q.stiffness": float(w0**2),
-                               "q.damping": 2 * ROTARY_PROBE_DAMPING * float(w0)}, t,
-                       exp.excitation, integrator=RK4(), outputs=chans)
-        y = (sim.outputs / scales[None, :]).ravel(order="F")[w]
-        inertia, explained = _probe_regression(y, J, r)
-        if inertia <= 0:
-            continue
-        if best is None or explained > best[2]:
-            best = (inertia, float(w0), explained)
-    return best
+    grid = abs(spin.rate) * np.geomspace(*ratios, n)
+    best = _scan_spin_probe(current, case, RotaryOscillator("q", axes=rotary_axes(rig)),
+                            [{"q.stiffness": float(w0**2),
+                              "q.damping": 2 * ROTARY_PROBE_DAMPING * float(w0)} for w0 in grid])
+    return None if best is None else (best[0], float(grid[best[1]]), best[2])
 
 
 def _rotary_proposal(model: Model, measurement, current: FitResult, evidence: Evidence,
