@@ -36,6 +36,9 @@ __all__ = ["fit", "Hessian"]
 _IPOPT_DEFAULTS = {
     "ipopt.print_level": 0, "print_time": False, "ipopt.sb": "yes", "ipopt.tol": 1e-8,
     "ipopt.max_iter": 300, "ipopt.mu_strategy": "adaptive", "ipopt.linear_solver": "mumps",
+    # QAMD orders the parameters' dense rows of the KKT matrix last: MUMPS's analysis
+    # 48 -> 14 ms and every factorisation cheaper (a 3001-sample fit 0.55 -> 0.48 s)
+    "ipopt.mumps_pivot_order": 6,
 }
 _IPOPT_HINTS = {
     "Maximum_Iterations_Exceeded": "raise `ipopt.max_iter` in solver_options, or start closer "
@@ -139,8 +142,15 @@ def fit(problem: FitProblem, *, transcription: Transcription = MultipleShooting(
     recorder = Recorder(nlp.w.numel(), nlp.g.numel(), len(est), scales, 2 * nlp.norm,
                          progress_printer(problem.names) if progress else None)
     opts["iteration_callback"] = recorder
+    g = nlp.g
+    if "jac_g" in opts:
+        # IPOPT gets g and its Jacobian from the per-interval functions (compiled when a
+        # compiler exists), and CasADi builds no AD of g: nothing asks for it once the
+        # multipliers of the (absent) NLP parameters are not computed
+        g = nlp.g_fast
+        opts.update({"no_nlp_grad": True, "calc_lam_p": False})
     opts.update(dict(solver_options or {}))
-    solver = ca.nlpsol("fit", "ipopt", {"x": nlp.w, "f": nlp.f, "g": nlp.g}, opts)
+    solver = ca.nlpsol("fit", "ipopt", {"x": nlp.w, "f": nlp.f, "g": g}, opts)
     lbx, ubx = nlp.bounds(est)
     with surfacing():  # an interrupt inside IPOPT is an interruption, not a non-convergence
         sol = solver(x0=nlp.w0, lbx=lbx, ubx=ubx, lbg=0, ubg=0)
@@ -227,6 +237,12 @@ class _Nlp:
     @property
     def f(self) -> ca.MX:
         return 0.5 * ca.sumsqr(self.r) / self.norm
+
+    @cached_property
+    def g_fast(self) -> ca.MX:
+        """``g`` evaluated with the per-interval value-and-Jacobian functions (possibly
+        compiled: no CasADi derivatives of it exist)."""
+        return ca.vertcat(*[t.block.g_fast for t in self.terms if t.block.g.numel()])
 
     @cached_property
     def jac_r(self) -> ca.MX:
