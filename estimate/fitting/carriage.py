@@ -27,9 +27,12 @@ import scipy.sparse as sps
 import scipy.sparse.linalg  # noqa: F401  (sps.linalg)
 from scipy.interpolate import BSpline
 
+from derive import Excitation
+
 from ..data.signals import noise_level, remove_tones, significant_frequencies, starts_quiet
 
-__all__ = ["CarriageSpline", "CarriageInput", "RecordNoise", "carriage_input", "record_noise"]
+__all__ = ["CarriageSpline", "CarriageInput", "SplineExcitation", "RecordNoise",
+           "carriage_input", "record_noise"]
 
 #: Knots per period of the highest significant carriage frequency.
 KNOTS_PER_PERIOD = 12
@@ -163,7 +166,28 @@ class CarriageInput:
 
     def values(self, coefficients: np.ndarray, times: np.ndarray) -> np.ndarray:
         """``(3, len(times))``: displacement (m), velocity (m/s), acceleration (m/s^2)."""
-        return np.vstack([self.design(times, d) @ coefficients for d in range(3)])
+        c = np.asarray(coefficients, float)
+        spline = BSpline(self.spline.knots, c if self.basis is None else self.basis @ c,
+                         self.spline.degree)
+        t = np.asarray(times, float)
+        return np.vstack([spline(t, nu=d) for d in range(3)])
+
+    def excitation(self, coefficients: np.ndarray) -> "SplineExcitation":
+        """The carriage motion of ``coefficients`` as a rig excitation."""
+        return SplineExcitation(self, np.asarray(coefficients, float))
+
+
+@dataclass(frozen=True)
+class SplineExcitation(Excitation):
+    """An estimated carriage motion (:class:`CarriageInput` and its coefficients) as the
+    rig excitation: the spline's exact displacement (m), velocity (m/s) and acceleration
+    (m/s^2) at any time of the record."""
+
+    carriage: CarriageInput = field(repr=False)
+    coefficients: np.ndarray = field(repr=False)
+
+    def values(self, t: np.ndarray) -> np.ndarray:
+        return self.carriage.values(self.coefficients, t)
 
 
 def _rest_basis(spline: CarriageSpline, t0: float) -> sps.csr_matrix:

@@ -12,7 +12,7 @@ import casadi as ca
 import numpy as np
 
 from analogs.errors import InputError
-from derive import OUTPUT_NAMES, RK4, Sampled, simulate
+from derive import OUTPUT_NAMES, RK4, simulate
 
 from ..data.signals import lowpass
 from .problem import FitProblem
@@ -125,7 +125,7 @@ def case_terms(problem: FitProblem, i: int, theta_s: ca.MX, transcription: Trans
         coef0 = carriage.coefficients
         if warm is not None and warm.carriage is not None and warm.carriage.size == coef0.size:
             coef0 = warm.carriage
-        excitation = Sampled(t, carriage.values(coef0, t))
+        excitation = carriage.excitation(coef0)
         coef = c
     else:
         excitation = exp.excitation
