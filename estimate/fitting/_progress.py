@@ -47,7 +47,7 @@ class Recorder(ca.Callback):
         return ca.Sparsity(0, 0)
 
     def eval(self, arg):
-        theta = np.asarray(arg[0]).ravel()[: self.ntheta] * self.scales
+        theta = np.asarray(arg[0][: self.ntheta]).ravel() * self.scales  # slice before copying
         cost = float(arg[1]) * self.cost_scale
         self.thetas.append(theta)
         self.costs.append(cost)

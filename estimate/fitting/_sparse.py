@@ -7,7 +7,7 @@ import casadi as ca
 import numpy as np
 import scipy.sparse as sps
 
-__all__ = ["sparse_dm", "scatter", "affine_parameters"]
+__all__ = ["sparse_dm", "scipy_csc", "scatter", "affine_parameters"]
 
 
 def sparse_dm(A: sps.spmatrix) -> ca.DM:
@@ -18,6 +18,14 @@ def sparse_dm(A: sps.spmatrix) -> ca.DM:
     C.sort_indices()
     sp = ca.Sparsity(C.shape[0], C.shape[1], C.indptr.tolist(), C.indices.tolist())
     return ca.DM(sp, C.data.tolist())
+
+
+def scipy_csc(M: ca.DM) -> sps.csc_matrix:
+    """A CasADi DM as a SciPy CSC matrix with the same sparsity (structural zeros kept),
+    from its compressed-column arrays (about twice as fast as ``DM.sparse()``)."""
+    sp = M.sparsity()
+    return sps.csc_matrix((np.array(M.nonzeros(), float), np.array(sp.row(), np.int64),
+                           np.array(sp.colind(), np.int64)), shape=(M.size1(), M.size2()))
 
 
 def scatter(values: ca.MX, shape: tuple[int, int], rows: np.ndarray, cols: np.ndarray,

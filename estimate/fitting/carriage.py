@@ -160,8 +160,18 @@ class CarriageInput:
 
             stage_times = (t[:-1, None] + np.diff(t)[:, None] * fr[None, :]).ravel()
             self._memo.clear()  # one grid at a time: these are large
-            self._memo[key] = (sparse_dm(self.inputs_matrix(stage_times)),
-                               sparse_dm(self.inputs_matrix(t)), sparse_dm(self.design(t)))
+            A_stage = sparse_dm(self.inputs_matrix(stage_times))
+            if fr[0] == 0.0 and fr[-1] == 1.0:
+                # the grid times are stage times (each interval's first, and the last
+                # interval's end): rows of A_stage, sliced in CasADi (no second conversion)
+                m, n = fr.size, t.size
+                k, i = np.arange(n)[:, None], np.arange(3)[None, :]
+                rows = np.where(k < n - 1, 3 * m * k + i, 3 * m * (n - 2) + 3 * (m - 1) + i)
+                A_grid = A_stage[rows.ravel().tolist(), :]
+                B0 = A_stage[rows[:, 0].tolist(), :]
+            else:
+                A_grid, B0 = sparse_dm(self.inputs_matrix(t)), sparse_dm(self.design(t))
+            self._memo[key] = (A_stage, A_grid, B0)
         return self._memo[key]
 
     def values(self, coefficients: np.ndarray, times: np.ndarray) -> np.ndarray:

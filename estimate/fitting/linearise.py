@@ -13,6 +13,7 @@ import numpy as np
 import scipy.sparse as sps
 import scipy.sparse.linalg as spla
 
+from ._sparse import scipy_csc
 from .covariance import ReducedKKT
 from .nlp import _setup
 from .problem import FitProblem
@@ -106,12 +107,12 @@ def linearise(problem: FitProblem, *, warm_start: FitResult | None = None,
     nlp, _ = _setup(problem, transcription, "squared", kinds, True, False, warm_start)
     w0 = nlp.w0
     e, Je = ca.Function("e", [nlp.w], [nlp.e, nlp.jac_r])(w0)
-    e, Je = np.asarray(e).ravel(), Je.sparse()
+    e, Je = np.asarray(e).ravel(), scipy_csc(Je)
     jac_g = nlp.constraint_jacobian(True)
     g, Jg = (jac_g(w0, []) if jac_g is not None
              else ca.Function("g", [nlp.w], [nlp.g, ca.jacobian(nlp.g, nlp.w)])(w0))
     g = np.asarray(g).ravel()
-    kkt = ReducedKKT(Je, Jg.sparse(), len(est))
+    kkt = ReducedKKT(Je, scipy_csc(Jg), len(est))
     scales = np.array([x.scale for x in est])
     return Linearisation(problem.names, scales, problem.initial, float(e @ e),
                          kkt.gradient(e, g), kkt.information, kkt, e, g)

@@ -25,6 +25,7 @@ from analogs.errors import InputError
 from ..data.case import KNOWN_INITIAL_STATES
 from ..interrupts import surfacing
 from ._progress import Recorder, progress_printer
+from ._sparse import scipy_csc
 from .covariance import reduced_jacobian, uncertainty
 from .problem import FitProblem
 from .result import FitResult, derived_quantities
@@ -162,7 +163,7 @@ def fit(problem: FitProblem, *, transcription: Transcription = MultipleShooting(
     out = nlp.error_function(cost)(w_opt)
     k = len(terms)
     _, Jg = solver.get_function("nlp_jac_g")(w_opt, [])
-    Je, Jg = out[1].sparse(), Jg.sparse()
+    Je, Jg = scipy_csc(out[1]), scipy_csc(Jg)
     J = reduced_jacobian(Je, Jg, len(est), scales, list(nlp.free_states))
     carriage = tuple(None if terms[i].carriage is None else np.asarray(out[4 + i])
                      for i in range(k))
@@ -285,20 +286,20 @@ class _Nlp:
         blocks = [t.block for t in self.terms]
         if not (blocks_ok and all(b.jac_w is not None or b.g.numel() == 0 for b in blocks)):
             return None
-        rows_t, locals_, g_fast = [], [], []
+        rows_t, locals_, g_jac = [], [], []
         for t in self.terms:
             b, nc = t.block, t.coef.numel()
             if b.g.numel():
                 jc = b.jac_c if b.jac_c is not None else ca.MX(b.g.numel(), nc)
                 rows_t.append(b.jac_theta)
                 locals_.append(ca.horzcat(b.jac_w, jc))
-                g_fast.append(b.g_fast)
+                g_jac.append(b.g_jac)
             else:
                 locals_.append(ca.MX(0, b.w.numel() + nc))
         if not rows_t:
             return None
         J = ca.horzcat(ca.vertcat(*rows_t), ca.diagcat(*locals_))
-        return ca.Function("nlp_jac_g", [self.w, ca.MX(0, 1)], [ca.vertcat(*g_fast), J],
+        return ca.Function("nlp_jac_g", [self.w, ca.MX(0, 1)], [ca.vertcat(*g_jac), J],
                            ["x", "p"], ["g", "jac_g_x"])
 
     def error_function(self, cost: str) -> ca.Function:

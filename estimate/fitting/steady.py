@@ -35,5 +35,6 @@ def steady_start(block: Block, dm: DerivedModel, p: ca.MX, theta: ca.MX, u0: np.
     if block.jac_c is not None:
         jac_c = ca.vertcat(block.jac_c, ca.MX(rows.numel(), n_coefficients))
     return replace(block, g=g, g_fast=ca.vertcat(block.g_fast, rows),
+                   g_jac=ca.vertcat(block.g_jac, rows),
                    jac_theta=ca.vertcat(block.jac_theta, ca.jacobian(rows, theta)),
                    jac_w=ca.vertcat(block.jac_w, ca.jacobian(rows, block.w)), jac_c=jac_c)

@@ -63,3 +63,19 @@ def test_covering_spline_spans_the_record_exactly():
     k = s.degree
     assert s.knots[k] == 0.3 and s.knots[-k - 1] == 7.3
     assert s.spacing <= 0.045
+
+
+@pytest.mark.parametrize("fractions", [(0.0, 0.5, 1.0), (0.155051, 0.644949, 1.0)])
+def test_casadi_matrices_are_the_design_matrices(carriage, fractions):
+    """The sparse CasADi matrices the NLP uses (stage inputs, grid inputs, grid
+    displacement) equal the SciPy design matrices, whether the grid rows are sliced from the
+    stage matrix (RK4 stages include both interval ends) or built on their own (Radau)."""
+    t, ci = carriage
+    fr = np.asarray(fractions)
+    A_stage, A_grid, B0 = ci.casadi_matrices(t, fr)
+    stages = (t[:-1, None] + np.diff(t)[:, None] * fr[None, :]).ravel()
+    for dm, ref in ((A_stage, ci.inputs_matrix(stages)), (A_grid, ci.inputs_matrix(t)),
+                    (B0, ci.design(t))):
+        got = dm.sparse()
+        assert got.shape == ref.shape
+        assert abs(got - ref).max() <= 1e-12 * abs(ref).max()

@@ -80,3 +80,35 @@ def test_six_channel_residual_jacobian_equals_automatic_differentiation(tmp_path
     w = nlp.w0 * (1 + 0.05 * np.random.default_rng(4).standard_normal(nlp.w0.size))
     assembled, automatic = (np.asarray(m.full()) for m in f(w))
     assert np.max(np.abs(assembled - automatic)) <= 1e-12 * np.max(np.abs(automatic))
+
+
+@pytest.mark.parametrize("compiled", [False, True])
+@pytest.mark.parametrize("variant", ["estimated rest", "estimated free", "two cases",
+                                     "filtered rest"])
+def test_constraint_jacobian_and_fast_constraints_equal_the_interpreted_ones(cases, variant,
+                                                                              compiled):
+    """What IPOPT evaluates: the constraint Jacobian assembled from per-interval blocks
+    (bidiagonal state blocks, block-diagonal input blocks times the carriage spline) equals
+    CasADi's automatic differentiation of the interpreted constraints, and the constraints
+    from the (compiled) step equal the interpreted ones; rounding only (1e-12 relative;
+    compiled C may round differently from CasADi's virtual machine)."""
+    from derive._compile import c_compiler
+
+    if compiled and c_compiler() is None:
+        pytest.skip("no C compiler")
+    ncases, spec, mode, measurement, start = VARIANTS[variant]
+    chosen = cases[:ncases]
+    problem = FitProblem.build(chosen if ncases > 1 else chosen[0],
+                               model_from_spec(spec, chosen[0]), input=mode)
+    nlp, _ = _setup(problem, MultipleShooting(), "squared", [start] * ncases, True, compiled,
+                    None)
+    jac_g = nlp.constraint_jacobian(True)
+    assert jac_g is not None
+    w = nlp.w0 * (1 + 0.05 * np.random.default_rng(5).standard_normal(nlp.w0.size))
+    g_blocks, J_blocks = (np.asarray(m.full()) for m in jac_g(w, []))
+    g, g_fast, J = (np.asarray(m.full()) for m in ca.Function(
+        "g", [nlp.w], [nlp.g, nlp.g_fast, ca.jacobian(nlp.g, nlp.w)])(w))
+    scale = np.max(np.abs(J))
+    assert np.max(np.abs(J_blocks - J)) <= 1e-12 * scale
+    for other in (g_blocks, g_fast):
+        assert np.max(np.abs(other - g)) <= 1e-12 * max(np.max(np.abs(w)), 1.0)
