@@ -16,6 +16,16 @@ __all__ = ["noise_level", "remove_tones", "starts_quiet"]
 _BAND_TOP = 0.9
 
 
+def _linear_detrend(segments: np.ndarray) -> np.ndarray:
+    """Each segment (last axis) minus its least-squares line: SciPy's ``detrend="linear"``
+    for all segments at once (it solves one least-squares problem per segment)."""
+    n = segments.shape[-1]
+    x = np.arange(n) - (n - 1) / 2
+    mean = segments.mean(axis=-1, keepdims=True)
+    slope = (segments @ x)[..., None] / (x @ x)
+    return segments - mean - slope * x
+
+
 def noise_level(time: ArrayLike, values: ArrayLike, *, above_hz: float) -> float:
     """Standard deviation of the white noise on ``values`` (same unit), from the Welch
     spectrum between ``above_hz`` and 0.9 times the Nyquist frequency.
@@ -35,7 +45,8 @@ def noise_level(time: ArrayLike, values: ArrayLike, *, above_hz: float) -> float
     """
     t, y, step = _as_uniform(time, values, "values")
     fs = 1.0 / step
-    f, p = signal.welch(y, fs=fs, window="hann", nperseg=min(t.size, 256), detrend="linear")
+    f, p = signal.welch(y, fs=fs, window="hann", nperseg=min(t.size, 256),
+                        detrend=_linear_detrend)
     band = (f >= above_hz) & (f <= _BAND_TOP * fs / 2)
     if np.count_nonzero(band) < 4:
         band = (f >= fs / 4) & (f <= _BAND_TOP * fs / 2)
@@ -69,7 +80,7 @@ def remove_tones(time: ArrayLike, values: ArrayLike, *, above_hz: float,
     if above_hz >= top:
         return y.copy(), ()
     nper = min(t.size, 256)
-    f, p = signal.welch(y, fs=fs, window="hann", nperseg=nper, detrend="linear")
+    f, p = signal.welch(y, fs=fs, window="hann", nperseg=nper, detrend=_linear_detrend)
     band = np.flatnonzero((f >= above_hz) & (f <= top))
     if band.size < 4:
         return y.copy(), ()

@@ -255,3 +255,13 @@ def test_drive_check_boundary_and_errors() -> None:
     assert not check_drive_frequency(T, force, 1.855, tolerance=0.01).passed
     with pytest.raises(ValueError, match=r"expected a positive `drive_frequency` in Hz, found 0"):
         check_drive_frequency(T, force, 0)
+
+
+def test_vectorised_linear_detrend_matches_scipy():
+    """The noise analysis's all-segments-at-once linear detrend is SciPy's per segment
+    (``signal.detrend(type="linear")``) to rounding."""
+    from estimate.data.signals.noise import _linear_detrend
+
+    segments = np.random.default_rng(4).normal(size=(7, 256)) + np.linspace(0, 3, 256)
+    assert np.allclose(_linear_detrend(segments), signal.detrend(segments, type="linear"),
+                       rtol=0, atol=1e-12)
