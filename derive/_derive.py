@@ -2,7 +2,9 @@
 
 from __future__ import annotations
 
+import threading
 import warnings
+from pathlib import Path
 
 from analogs.component import SourceUnavailable
 from analogs.model import Model
@@ -44,6 +46,10 @@ def derive(model: Model, *, use_cache: bool = True) -> DerivedModel:
             key = cache.cache_key(model.structure_key())
         except SourceUnavailable as err:
             _warn_uncached(err)
+    live = _live_entry(key) if key is not None else None
+    if live is not None:
+        fns, meta, memo = live
+        return _derived_model(model, fns, meta, memo, from_cache=True)
     hit = cache.load(key) if key is not None else None
     if hit is not None:
         fns, meta = hit
@@ -65,6 +71,14 @@ def derive(model: Model, *, use_cache: bool = True) -> DerivedModel:
         if key is not None:
             cache.store(key, fns, meta)
         from_cache = False
+    memo: dict = {}
+    if key is not None:
+        _keep_live(key, fns, meta, memo)
+    return _derived_model(model, fns, meta, memo, from_cache=from_cache)
+
+
+def _derived_model(model: Model, fns: dict, meta: dict, memo: dict, *,
+                   from_cache: bool) -> DerivedModel:
     return DerivedModel(
         model=model,
         coordinates=tuple(meta["coordinates"]),
@@ -78,7 +92,48 @@ def derive(model: Model, *, use_cache: bool = True) -> DerivedModel:
         forcing=fns["forcing"],
         dependencies={k: tuple(v) for k, v in meta["dependencies"].items()},
         from_cache=from_cache,
+        _memo=memo,
     )
+
+
+#: Derived structures kept in memory, per thread (CasADi's symbolic objects are not shared
+#: between threads): a process that fits many records or models (a diagnosis, a campaign)
+#: loads each structure once and keeps the functions built from it (maps, compiled RK4
+#: steps, simulators) in the shared ``_memo``. An entry is used only while the cache file
+#: it came from is unchanged (same size and modification time), so a rewritten, damaged or
+#: removed entry is read again.
+_LIVE = threading.local()
+_LIVE_SIZE = 8
+
+
+def _stamp(key: str) -> tuple | None:
+    path = cache.cache_dir() / f"{key}.json"
+    try:
+        st = path.stat()
+    except OSError:
+        return None
+    return (str(Path(path).resolve()), st.st_ino, st.st_size, st.st_mtime_ns)
+
+
+def _live_entry(key: str):
+    entries = getattr(_LIVE, "entries", None)
+    if not entries or key not in entries:
+        return None
+    stamp, value = entries[key]
+    if stamp is None or stamp != _stamp(key):
+        del entries[key]
+        return None
+    return value
+
+
+def _keep_live(key: str, fns: dict, meta: dict, memo: dict) -> None:
+    entries = getattr(_LIVE, "entries", None)
+    if entries is None:
+        entries = _LIVE.entries = {}
+    entries.pop(key, None)
+    entries[key] = (_stamp(key), (fns, meta, memo))
+    while len(entries) > _LIVE_SIZE:
+        entries.pop(next(iter(entries)))
 
 
 _WARNED: set[tuple[str, int]] = set()

@@ -55,6 +55,15 @@ class DerivedModel:
     from_cache: bool = field(default=False, compare=False)
     _memo: dict = field(default_factory=dict, compare=False, repr=False)
 
+    def mapped(self, key: tuple, fn: ca.Function, n: int) -> ca.Function:
+        """``fn.map(n)``, kept with the model's functions under ``key`` (which must name
+        ``fn``): CasADi builds a map's sparsity patterns when it is created, milliseconds
+        for a long record, and a fit creates several."""
+        k = ("map", key, n)
+        if k not in self._memo:
+            self._memo[k] = fn.map(n)
+        return self._memo[k]
+
     @property
     def states(self) -> tuple[str, ...]:
         """State names: coordinates then ``<coordinate>_dot``."""

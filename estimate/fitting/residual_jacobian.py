@@ -64,7 +64,8 @@ def force_residual_jacobian(dm: DerivedModel, channels: tuple[str, ...], X: ca.M
     ntheta = theta.numel()
     p0, S = affine_parameters(p, theta)
     fn = output_jacobian(dm, channels, ntheta, compiled)
-    Jx, Ju, Jt = fn.map(n)(X, Ug, p0, ca.vec(S), theta, ca.DM(t).T)
+    Jx, Ju, Jt = dm.mapped(("output_jacobian", channels, ntheta, compiled), fn, n)(
+        X, Ug, p0, ca.vec(S), theta, ca.DM(t).T)
     k = np.arange(n)
     ch = np.arange(nch)
 

@@ -24,6 +24,14 @@ __all__ = ["CaseTerms", "WarmStart", "case_terms"]
 
 
 def _measured_output(dm, channels: tuple[str, ...]) -> ca.Function:
+    """``(x, u, p, t) -> y``: the measured ``channels`` (built once per model)."""
+    key = ("measured_output", channels)
+    if key not in dm._memo:
+        dm._memo[key] = _measured_output_function(dm, channels)
+    return dm._memo[key]
+
+
+def _measured_output_function(dm, channels: tuple[str, ...]) -> ca.Function:
     x = ca.SX.sym("x", dm.nx)
     u = ca.SX.sym("u", dm.nu)
     p = ca.SX.sym("p", len(dm.parameter_names))
@@ -148,7 +156,8 @@ def case_terms(problem: FitProblem, i: int, theta_s: ca.MX, transcription: Trans
         block = steady_start(block, dm, p_i, theta_s, np.asarray(u0).ravel(), float(t[0]),
                              coef.numel())
     chans = problem.channels(i)
-    Y = _measured_output(dm, chans).map(n)(block.X, Ug, p_i, ca.DM(t).T).T
+    Y = dm.mapped(("measured_output", chans), _measured_output(dm, chans), n)(
+        block.X, Ug, p_i, ca.DM(t).T).T
     mvals = {e.parameter: theta_s[j] * e.scale for j, e in enumerate(problem.estimated)
              if e.case in (None, i)}
     extras = [x for x in (mm.term(Ug, dm.inputs, mvals, t) for mm in problem.measurement)

@@ -109,19 +109,22 @@ class MultipleShooting(Transcription):
         step = rk4_step(dm, self.substeps)
         tk, hk = ca.DM(t[:-1]).T, ca.DM(np.diff(t)).T
         if theta is None or dm.nx == 0:
-            xn = step.map(n - 1)(X[:, :-1], U, p, tk, hk)
+            xn = dm.mapped(("rk4_step", self.substeps), step, n - 1)(X[:, :-1], U, p, tk, hk)
             return Block(ca.vec(W), np.asarray(w0).ravel(order="F"), ca.vec(X[:, 1:] - xn), X)
         # p = p0 + S theta (affine); per-interval value and Jacobians in one function
         p0, S = affine_parameters(p, theta)
         fn = _step_jacobian(dm, self.substeps, theta.numel(), compiled)
-        xn, JxT, JtT, JuT = fn.map(n - 1)(X[:, :-1], U, p0, ca.vec(S), theta, tk, hk)
+        xn, JxT, JtT, JuT = dm.mapped(("rk4_jacobian", self.substeps, theta.numel(), compiled),
+                                      fn, n - 1)(X[:, :-1], U, p0, ca.vec(S), theta, tk, hk)
         # g stays differentiable by CasADi (interpreted step); what IPOPT evaluates is
         # g_fast, from the compiled step when there is one (a third of the time)
-        g = ca.vec(X[:, 1:] - step.map(n - 1)(X[:, :-1], U, p, tk, hk))
+        g = ca.vec(X[:, 1:] - dm.mapped(("rk4_step", self.substeps), step, n - 1)(
+            X[:, :-1], U, p, tk, hk))
         g_fast = g
         if compiled:
-            g_fast = ca.vec(X[:, 1:] - _compiled_step(dm, self.substeps).map(n - 1)(
-                X[:, :-1], U, p, tk, hk))
+            g_fast = ca.vec(X[:, 1:] - dm.mapped(
+                ("rk4_step_compiled", self.substeps), _compiled_step(dm, self.substeps),
+                n - 1)(X[:, :-1], U, p, tk, hk))
         jac_theta = -JtT.T  # rows of interval k stacked: (nx (n-1)) x ntheta
         jac_w = _bidiagonal(dm.nx, n, -JxT, fixed_start=x0 is not None)
         jac_c = None

@@ -155,3 +155,28 @@ def test_a_cache_folder_writable_by_others_is_refused(tmp_path, monkeypatch):
     monkeypatch.setenv("SLOSH_CACHE_DIR", str(folder))
     with pytest.raises(PermissionError, match="writable by other users"):
         derive(_two_pendulum())
+
+
+def test_a_structure_is_kept_in_memory_per_thread_until_its_entry_changes(tmp_path,
+                                                                          monkeypatch):
+    """A second derive of the same structure in the same thread reuses the loaded functions
+    and what was built from them (the memo), with the caller's own model; another thread
+    loads its own copy; a cache entry rewritten on disk is read again."""
+    import threading
+
+    monkeypatch.setenv("SLOSH_CACHE_DIR", str(tmp_path))
+    first = derive(_two_pendulum())
+    again_model = _two_pendulum()
+    again = derive(again_model)
+    assert again.rhs is first.rhs and again._memo is first._memo
+    assert again.model is again_model and again.from_cache
+    other = {}
+    thread = threading.Thread(target=lambda: other.setdefault("dm", derive(_two_pendulum())))
+    thread.start()
+    thread.join()
+    assert other["dm"].rhs is not first.rhs and other["dm"]._memo is not first._memo
+    (entry,) = tmp_path.glob("*.json")
+    st = entry.stat()
+    os.utime(entry, ns=(st.st_atime_ns, st.st_mtime_ns + 10**9))
+    reread = derive(_two_pendulum())
+    assert reread.rhs is not first.rhs and reread.from_cache
