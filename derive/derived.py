@@ -23,6 +23,11 @@ OUTPUT_NAMES = (
 OUTPUT_UNITS = ("N", "N", "N", "N m", "N m", "N m", "J", "J")
 
 
+#: Maps kept per derived structure (:meth:`DerivedModel.mapped`): a fit makes five or six,
+#: so a process fitting records of several lengths keeps the latest few lengths' maps.
+_MAPS_KEPT = 32
+
+
 class ParameterError(InputError):
     """Parameter values that are unknown to the model, missing, or out of bounds."""
 
@@ -61,6 +66,9 @@ class DerivedModel:
         for a long record, and a fit creates several."""
         k = ("map", key, n)
         if k not in self._memo:
+            maps = [m for m in self._memo if m[0] == "map"]
+            if len(maps) >= _MAPS_KEPT:  # many record lengths in one process: oldest out
+                del self._memo[maps[0]]
             self._memo[k] = fn.map(n)
         return self._memo[k]
 

@@ -180,3 +180,22 @@ def test_a_structure_is_kept_in_memory_per_thread_until_its_entry_changes(tmp_pa
     os.utime(entry, ns=(st.st_atime_ns, st.st_mtime_ns + 10**9))
     reread = derive(_two_pendulum())
     assert reread.rhs is not first.rhs and reread.from_cache
+
+
+def test_maps_are_built_once_per_length_and_the_oldest_lengths_leave(tmp_path, monkeypatch):
+    """``DerivedModel.mapped``: the same map object for the same function and length, its
+    values those of ``fn.map``; beyond the kept number of lengths the oldest is rebuilt."""
+    from derive import derived
+
+    monkeypatch.setenv("SLOSH_CACHE_DIR", str(tmp_path))
+    dm = derive(_two_pendulum())
+    f = dm.rhs
+    first = dm.mapped(("rhs",), f, 5)
+    assert dm.mapped(("rhs",), f, 5) is first
+    args = (np.ones((4, 5)), np.zeros((3, 5)), np.arange(1, len(dm.parameter_names) + 1.0),
+            np.zeros((1, 5)))
+    assert np.array_equal(np.asarray(first(*args)), np.asarray(f.map(5)(*args)))
+    for n in range(6, 6 + derived._MAPS_KEPT):
+        dm.mapped(("rhs",), f, n)
+    assert sum(1 for k in dm._memo if k[0] == "map") == derived._MAPS_KEPT
+    assert dm.mapped(("rhs",), f, 5) is not first
