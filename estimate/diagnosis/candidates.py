@@ -54,6 +54,9 @@ class Proposal:
     #: start values of the new parameters read off the amplitude evidence, for a fit
     #: started from the tank prediction instead of the current estimates (``None``: none)
     cold_start: Mapping[str, float] | None = None
+    #: other start values of the new parameters, over the current estimates, for a second
+    #: fit when the first does not converge or leaves the residual far above the noise
+    retry: Mapping[str, float] | None = None
     #: the objective reduction the candidate's screening predicts, over the residual
     #: variance (a score statistic; NaN: none, e.g. a spring with a held length)
     score: float = math.nan
@@ -404,13 +407,18 @@ def propose(model: Model, measurement: tuple[MeasurementModel, ...], current: Fi
 
         # the scan's linear probe reads the mass off the response amplitude, which a mode
         # swinging far into its nonlinear range (tenths of a radian in a sweep through it)
-        # does not have: a fit from the tank's prediction of that mode at the scanned
-        # frequency is the cold start (F60_sweep_0.6mm: the scan read 0.008 kg of 0.048)
-        cold = {f"{name}.length": L0} if f"{name}.mass" in predicted else None
+        # does not have: when that start fails, the tank's prediction of the mode's mass at
+        # the scanned frequency is the second (F60_sweep_0.6mm: the scan read 0.008 kg of
+        # 0.048 and its fit ran out of iterations)
+        retry = None
+        if f"{name}.mass" in predicted:
+            mp = predicted[f"{name}.mass"]
+            retry = {f"{name}.mass": mp, f"{name}.length": L0,
+                     f"{name}.damping": 2 * 0.01 * mp * L0**2 * 2 * math.pi * f0}
         out.append(Proposal(
             "slosh_mode", (name,), model + Pendulum(name) + HingeDamper(name), measurement,
             {f"{name}.mass": m0, f"{name}.length": L0, f"{name}.damping": c0},
-            score=statistic, cold_start=cold,
+            score=statistic, retry=retry,
             bounds={f"{name}.length": (0.8 * L0, 1.25 * L0),
                     f"{name}.mass": (1e-6, min(m1, max(5 * predicted.get(f"{name}.mass", 0.0), 0.1 * m1)))},
             plausible=plausible_mode,

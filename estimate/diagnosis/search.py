@@ -469,6 +469,11 @@ def _try(fitter: _Fitter, prop: Proposal, current: FitResult, score: float, rms0
                 if cold is not None and \
                         (cold.converged, -cold.objective) > (res.converged, -res.objective):
                     res = cold
+            if prop.retry is not None and (not res.converged or poor_start(current, res)):
+                again = fitter(prop.model, prop.measurement, start | dict(prop.retry),
+                               prop.bounds, warm=current)
+                if (again.converged, -again.objective) > (res.converged, -res.objective):
+                    res = again
     except (ValueError, RuntimeError) as err:
         return CandidateOutcome(prop.cause, prop.added, rms0, math.nan, -math.inf, math.inf,
                                 f"fit failed: {err}", "", current, score=score)
