@@ -4,7 +4,6 @@ from __future__ import annotations
 
 import threading
 import warnings
-from pathlib import Path
 
 from analogs.component import SourceUnavailable
 from analogs.model import Model
@@ -112,7 +111,7 @@ def _stamp(key: str) -> tuple | None:
         st = path.stat()
     except OSError:
         return None
-    return (str(Path(path).resolve()), st.st_ino, st.st_size, st.st_mtime_ns)
+    return (str(path.resolve()), st.st_ino, st.st_size, st.st_mtime_ns)
 
 
 def _live_entry(key: str):

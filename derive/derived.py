@@ -3,9 +3,10 @@
 from __future__ import annotations
 
 import math
-from collections.abc import Mapping
+from collections.abc import Callable, Mapping
 from dataclasses import dataclass, field
 from functools import cached_property
+from typing import Any
 
 import casadi as ca
 import numpy as np
@@ -60,6 +61,13 @@ class DerivedModel:
     from_cache: bool = field(default=False, compare=False)
     _memo: dict = field(default_factory=dict, compare=False, repr=False)
 
+    def memoized(self, key: tuple, build: Callable[[], Any]) -> Any:
+        """``build()``, called once per ``key`` and kept with the model's functions (shared
+        by every derive of the same structure in this thread)."""
+        if key not in self._memo:
+            self._memo[key] = build()
+        return self._memo[key]
+
     def mapped(self, key: tuple, fn: ca.Function, n: int) -> ca.Function:
         """``fn.map(n)``, kept with the model's functions under ``key`` (which must name
         ``fn``): CasADi builds a map's sparsity patterns when it is created, milliseconds
@@ -69,8 +77,7 @@ class DerivedModel:
             maps = [m for m in self._memo if m[0] == "map"]
             if len(maps) >= _MAPS_KEPT:  # many record lengths in one process: oldest out
                 del self._memo[maps[0]]
-            self._memo[k] = fn.map(n)
-        return self._memo[k]
+        return self.memoized(k, lambda: fn.map(n))
 
     @property
     def states(self) -> tuple[str, ...]:

@@ -16,6 +16,7 @@ Examples
 from .damping import cylinder_damping, damping_validity, sphere_damping
 from .geometry import WATER, Capsule, Cylinder, Liquid, Profile, Sphere, Tank
 from .prediction import (
+                         METHODS,
                          Exact,
                          FiniteElements,
                          FixedMassPrediction,
@@ -34,6 +35,7 @@ __all__ = [
     "FiniteElements",
     "FixedMassPrediction",
     "Legacy",
+    "METHODS",
     "Liquid",
     "Profile",
     "Ritz",

@@ -104,7 +104,8 @@ class Exact:
 
 
 Solver = Union[Exact, Ritz, FiniteElements, Legacy]
-_METHODS = {"exact": Exact, "ritz": Ritz, "fem": FiniteElements, "legacy": Legacy}
+#: The solvers by name (``predict(..., method="exact")``).
+METHODS = {"exact": Exact, "ritz": Ritz, "fem": FiniteElements, "legacy": Legacy}
 
 
 # -- results -------------------------------------------------------------------------------
@@ -255,9 +256,9 @@ def _damping(tank: Tank, depth: float, liquid: Liquid, gravity: float) -> tuple[
 def _solver(method: str | Solver) -> Solver:
     if isinstance(method, str):
         try:
-            return _METHODS[method]()
+            return METHODS[method]()
         except KeyError:
-            raise ValueError(f"`method` must be one of {sorted(_METHODS)} or a solver object "
+            raise ValueError(f"`method` must be one of {sorted(METHODS)} or a solver object "
                              f"(`Ritz()`, `FiniteElements()`, `Legacy()`); got {method!r}."
                              ) from None
     if not hasattr(method, "solve"):

@@ -389,7 +389,11 @@ def propose(model: Model, measurement: tuple[MeasurementModel, ...], current: Fi
     if f0 is not None:
         L0 = gravity / (2 * math.pi * f0) ** 2
         m0 = m0 if m0 is not None else predicted.get(f"{name}.mass", 0.04 * m1)
-        c0 = 2 * 0.01 * m0 * L0**2 * 2 * math.pi * f0
+
+        def damping(m: float, L0=L0, f0=f0) -> float:  # 1 % of critical at f0
+            return 2 * 0.01 * m * L0**2 * 2 * math.pi * f0
+
+        c0 = damping(m0)
 
         def plausible_mode(r: FitResult, name=name, prev=pend[-1] if pend else None) -> str | None:
             m, f = r.value(f"{name}.mass"), _freq(r, name)
@@ -414,7 +418,7 @@ def propose(model: Model, measurement: tuple[MeasurementModel, ...], current: Fi
         if f"{name}.mass" in predicted:
             mp = predicted[f"{name}.mass"]
             retry = {f"{name}.mass": mp, f"{name}.length": L0,
-                     f"{name}.damping": 2 * 0.01 * mp * L0**2 * 2 * math.pi * f0}
+                     f"{name}.damping": damping(mp)}
         out.append(Proposal(
             "slosh_mode", (name,), model + Pendulum(name) + HingeDamper(name), measurement,
             {f"{name}.mass": m0, f"{name}.length": L0, f"{name}.damping": c0},

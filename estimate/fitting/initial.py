@@ -31,18 +31,16 @@ def tank_prediction(shape: str, radius: float, fill: float, *, density: float,
     height, density in kg/m^3, kinematic viscosity in m^2/s, gravity in m/s^2. The modal
     analysis is kept on disk (:mod:`estimate.fitting._tank_cache`): a tank and fill seen
     before costs no solve."""
-    from analogs.tank import Cylinder, Exact, FiniteElements, Legacy, Liquid, Ritz, Sphere, predict
+    from analogs.tank import METHODS, Cylinder, Liquid, Sphere, predict
 
     from ._tank_cache import CachedSolver
 
     tank = Sphere(radius) if shape == "sphere" else Cylinder(radius, 2 * radius)
-    solvers = {"exact": Exact, "ritz": Ritz, "fem": FiniteElements, "legacy": Legacy}
-    if method not in solvers:
-        raise InputError(f"tank modal analysis method must be one of {', '.join(solvers)}, "
+    if method not in METHODS:
+        raise InputError(f"tank modal analysis method must be one of {', '.join(METHODS)}, "
                          f"got {method!r}")
-    # the modal analysis of a tank and fill is computed once and kept on disk
     return predict(tank, fill=fill, liquid=Liquid(density=density, viscosity=viscosity),
-                   gravity=gravity, modes=modes, method=CachedSolver(solvers[method]()),
+                   gravity=gravity, modes=modes, method=CachedSolver(METHODS[method]()),
                    diaphragm=diaphragm)
 
 

@@ -246,8 +246,8 @@ class _Nlp:
 
     @cached_property
     def g_fast(self) -> ca.MX:
-        """``g`` evaluated with the per-interval value-and-Jacobian functions (possibly
-        compiled: no CasADi derivatives of it exist)."""
+        """``g`` as IPOPT evaluates it: each block's ``g_fast`` (the compiled RK4 step when
+        there is one, so CasADi cannot differentiate it)."""
         return ca.vertcat(*[t.block.g_fast for t in self.terms if t.block.g.numel()])
 
     @cached_property

@@ -25,10 +25,8 @@ __all__ = ["CaseTerms", "WarmStart", "case_terms"]
 
 def _measured_output(dm, channels: tuple[str, ...]) -> ca.Function:
     """``(x, u, p, t) -> y``: the measured ``channels`` (built once per model)."""
-    key = ("measured_output", channels)
-    if key not in dm._memo:
-        dm._memo[key] = _measured_output_function(dm, channels)
-    return dm._memo[key]
+    return dm.memoized(("measured_output", channels),
+                       lambda: _measured_output_function(dm, channels))
 
 
 def _measured_output_function(dm, channels: tuple[str, ...]) -> ca.Function:

@@ -138,12 +138,10 @@ class MultipleShooting(Transcription):
 
 def _compiled_step(dm: DerivedModel, substeps: int) -> ca.Function:
     """:func:`derive.rk4_step` compiled to C (once per model and substeps)."""
-    key = ("rk4_step_compiled", substeps)
-    if key not in dm._memo:
-        from derive._compile import compiled as compile_fn
+    from derive._compile import compiled as compile_fn
 
-        dm._memo[key] = compile_fn(rk4_step(dm, substeps))
-    return dm._memo[key]
+    return dm.memoized(("rk4_step_compiled", substeps),
+                       lambda: compile_fn(rk4_step(dm, substeps)))
 
 
 def _step_jacobian(dm: DerivedModel, substeps: int, ntheta: int, compiled: bool) -> ca.Function:
