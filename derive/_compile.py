@@ -3,10 +3,13 @@
 Generated C is keyed by a hash of the serialized function, so a library is built once per
 function and reused across processes. The SHA-256 of every library is stored beside it
 (``<lib>.sha256``) and checked before the library is loaded: a truncated or altered library
-is rebuilt (with a warning), never loaded. Libraries live in the private cache folder
-(:func:`derive.cache.ensure_private_dir`) and one writable by others is refused. When no
-compiler is available the CasADi virtual machine function is returned unchanged, with a
-warning.
+is rebuilt (with a warning), never loaded. Libraries and their hashes live in the cache's
+``compiled/`` folder, used only while it and every folder above it up to the cache root,
+the library and its hash belong to the user and nobody else can write to them
+(:func:`derive.cache.cache_folder`): the hash proves nothing when another user could write
+both, so such a folder is not read at all and the library is built in a private temporary
+folder instead. When no compiler is available the CasADi virtual machine function is
+returned unchanged, with a warning.
 """
 
 from __future__ import annotations
@@ -14,7 +17,6 @@ from __future__ import annotations
 import hashlib
 import os
 import shutil
-import stat
 import subprocess
 import tempfile
 import warnings
@@ -22,7 +24,7 @@ from pathlib import Path
 
 import casadi as ca
 
-from .cache import cache_dir, ensure_private_dir
+from .cache import UntrustedCache, cache_folder, file_problem
 
 __all__ = ["compiled", "c_compiler"]
 
@@ -42,12 +44,14 @@ def _file_digest(path: Path) -> str:
 
 
 def _trusted(lib: Path) -> bool:
-    """The library exists, is not writable by others and matches its stored hash."""
+    """The library exists, belongs to the user, nobody else can write to it or to its hash,
+    and it matches its stored hash."""
     stamp = lib.with_name(lib.name + ".sha256")
     if not lib.exists():
         return False
-    if lib.stat().st_mode & (stat.S_IWGRP | stat.S_IWOTH):
-        warnings.warn(f"{lib} is writable by other users; rebuilding it", RuntimeWarning,
+    why = file_problem(lib) or file_problem(stamp)
+    if why:
+        warnings.warn(f"compiled library not loaded: {why}; rebuilding it", UntrustedCache,
                       stacklevel=4)
         return False
     try:
@@ -65,7 +69,7 @@ def compiled(fn: ca.Function) -> ca.Function:
     key = hashlib.sha256(fn.serialize().encode()).hexdigest()[:24]
     if key in _LOADED:
         return _LOADED[key]
-    folder = ensure_private_dir(cache_dir() / "compiled")
+    folder = cache_folder("compiled")
     lib = folder / f"{fn.name()}_{key}.so"
     if not _trusted(lib):
         cc = c_compiler()

@@ -9,7 +9,10 @@ Entries are JSON files holding serialized CasADi functions, metadata and a SHA-2
 a truncated, empty or altered entry fails the check and is rebuilt. Entries are written to a
 temporary file in the cache folder and renamed into place, so concurrent writers never leave
 a half-written entry. A cache hit imports no SymPy. The folder is ``$SLOSH_CACHE_DIR`` or
-``~/.cache/slosh-analogs``, created private to the user (mode 0700).
+``~/.cache/slosh-analogs``, created private to the user (mode 0700). It is used only while
+it, every folder below it on the way to an entry, and the entry itself belong to the user
+and nobody else can write to them (symlinks resolved; :mod:`derive._trust`); otherwise the
+command says so once and caches in a private temporary folder for the run.
 """
 
 from __future__ import annotations
@@ -18,7 +21,6 @@ import functools
 import hashlib
 import json
 import os
-import stat
 import tempfile
 import warnings
 from importlib import metadata
@@ -26,29 +28,45 @@ from pathlib import Path
 
 import casadi as ca
 
-__all__ = ["cache_dir", "cache_key", "ensure_private_dir", "load", "store"]
+from ._trust import UntrustedCache, file_problem, folder_problem, private_folder
+
+__all__ = ["UntrustedCache", "cache_dir", "cache_key", "cache_folder", "configured_dir",
+           "ensure_private_dir", "file_problem", "load", "store"]
 
 _FUNCTIONS = ("rhs", "outputs", "mass_matrix", "forcing")
 
 
-def cache_dir() -> Path:
-    """The cache folder (created on first store)."""
+def configured_dir() -> Path:
+    """The configured cache folder: ``$SLOSH_CACHE_DIR`` or ``~/.cache/slosh-analogs``."""
     env = os.environ.get("SLOSH_CACHE_DIR")
     return Path(env) if env else Path.home() / ".cache" / "slosh-analogs"
 
 
-def ensure_private_dir(folder: Path) -> Path:
-    """Create ``folder`` (mode 0700) if needed and check that nobody else can write to it.
+def cache_folder(*parts: str) -> Path:
+    """The sub-folder ``parts`` of the cache in use, created private to the user: of
+    :func:`configured_dir` when it and everything on the way is private to the user, else
+    of a private temporary folder of this process (with one :class:`UntrustedCache`
+    warning)."""
+    return private_folder(configured_dir(), *parts)
 
-    Raises ``PermissionError`` for a folder writable by group or others: native code and
+
+def cache_dir() -> Path:
+    """The cache folder in use (see :func:`cache_folder`)."""
+    return cache_folder()
+
+
+def ensure_private_dir(folder: Path) -> Path:
+    """Create ``folder`` (mode 0700) if needed and check that nobody else can change it or
+    a folder above it.
+
+    Raises ``PermissionError`` naming the folder that is not private: native code and
     serialized functions are loaded from it."""
     folder.mkdir(mode=0o700, parents=True, exist_ok=True)
-    mode = folder.stat().st_mode
-    if mode & (stat.S_IWGRP | stat.S_IWOTH):
-        raise PermissionError(
-            f"the derivation cache folder {folder} is writable by other users (mode "
-            f"{stat.S_IMODE(mode):o}); run `chmod go-w {folder}` or set SLOSH_CACHE_DIR to a "
-            "private folder")
+    why = folder_problem(folder)
+    if why:
+        raise PermissionError(f"the derivation cache folder {folder} cannot be trusted: {why}; "
+                              f"run `chmod go-w {folder}` or set SLOSH_CACHE_DIR to a private "
+                              "folder")
     return folder
 
 
@@ -93,6 +111,11 @@ def load(key: str) -> tuple[dict[str, ca.Function], dict] | None:
     path = cache_dir() / f"{key}.json"
     if not path.exists():
         return None
+    why = file_problem(path)
+    if why:
+        warnings.warn(f"derivation cache entry not read: {why}; deriving anew", UntrustedCache,
+                      stacklevel=3)
+        return None
     try:
         data = json.loads(path.read_text())
         if data.get("sha256") != _checksum(data["meta"], data["functions"]):
@@ -107,7 +130,7 @@ def load(key: str) -> tuple[dict[str, ca.Function], dict] | None:
 
 def store(key: str, functions: dict[str, ca.Function], meta: dict) -> Path:
     """Write functions and metadata atomically; return the file path."""
-    folder = ensure_private_dir(cache_dir())
+    folder = cache_dir()
     serialized = {n: functions[n].serialize() for n in _FUNCTIONS}
     data = {"meta": meta, "functions": serialized, "sha256": _checksum(meta, serialized)}
     fd, tmp = tempfile.mkstemp(dir=folder, suffix=".tmp")

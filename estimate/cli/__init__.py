@@ -6,6 +6,8 @@ from __future__ import annotations
 import argparse
 import os
 import sys
+from collections.abc import Iterator
+from contextlib import contextmanager
 
 __all__ = ["main"]
 
@@ -39,7 +41,7 @@ def main(argv: list[str] | None = None) -> int:
 
     from ..interrupts import Interrupted, handled, received
 
-    with handled(f"slosh {args.command}"):
+    with handled(f"slosh {args.command}"), _one_line_warnings():
         try:
             status = args.run(args)
         except Interrupted as err:
@@ -55,6 +57,21 @@ def main(argv: list[str] | None = None) -> int:
         if received() is not None:  # arrived while the outputs were being renamed
             return _interrupted(args.command, Interrupted(received()), written=True)
     return int(status or 0)
+
+
+@contextmanager
+def _one_line_warnings() -> Iterator[None]:
+    """Warnings of the command on stderr as ``warning: message``, without Python's source
+    line; each message once."""
+    import warnings
+
+    def show(message, category, filename, lineno, file=None, line=None):
+        print(f"warning: {message}", file=sys.stderr if file is None else file)
+
+    with warnings.catch_warnings():
+        warnings.simplefilter("default")
+        warnings.showwarning = show
+        yield
 
 
 def _interrupted(command: str, err, *, written: bool) -> int:

@@ -1,12 +1,13 @@
 """Tank modal analyses kept on disk: the raw modes of a tank, depth and solver are computed
 once (0.02-0.3 s each) and read back by every later fit, diagnosis or check of the same tank.
 
-Entries live in the derivation cache folder (:func:`derive.cache.cache_dir`, private to the
-user) under ``tank/``, keyed by the solver, the tank, the liquid depth, the number of modes
-and a hash of the source of the ``analogs.tank`` package and the library versions; each
-holds a SHA-256 of its content and is written to a temporary file then renamed. A missing,
-damaged or unreadable entry is computed anew (and rewritten); a folder that cannot be
-written leaves the result uncached.
+Entries live in the derivation cache folder under ``tank/``
+(:func:`derive.cache.cache_folder`: read only while nobody but the user can change it or the
+entry), keyed by the solver, the tank, the liquid depth, the number of modes and a hash of
+the source of the ``analogs.tank`` package and the library versions; each holds a SHA-256 of
+its content and is written to a temporary file then renamed. A missing, damaged or
+unreadable entry, or one another user could have written, is computed anew (and rewritten);
+a folder that cannot be written leaves the result uncached.
 """
 
 from __future__ import annotations
@@ -56,23 +57,20 @@ class CachedSolver:
         return self.solver.name
 
     def _path(self, tank, depth: float, n_modes: int) -> Path:
-        from derive.cache import cache_dir
+        from derive.cache import cache_folder
 
         key = hashlib.sha256(f"{self.solver!r}|{tank!r}|{depth!r}|{n_modes}|"
                              f"{_source_digest()}".encode()).hexdigest()[:32]
-        return cache_dir() / "tank" / f"{key}.json"
+        return cache_folder("tank") / f"{key}.json"
 
     def solve(self, tank, depth: float, n_modes: int):
         from analogs.tank._modes import RawModes
-        from derive.cache import cache_dir, ensure_private_dir
+        from derive.cache import file_problem
 
         path = self._path(tank, depth, n_modes)
-        try:  # only a folder nobody else can write to is read (or written)
-            ensure_private_dir(cache_dir())
-            ensure_private_dir(path.parent)
-        except OSError:
-            return self.solver.solve(tank, depth, n_modes)
         try:
+            if file_problem(path):  # written by someone else: computed anew below
+                raise ValueError("not private")
             data = json.loads(path.read_text())
             if data.pop("sha256") == _checksum(data):
                 return RawModes(**{k: np.asarray(data[k], float) for k in _FIELDS},

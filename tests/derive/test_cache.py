@@ -148,13 +148,20 @@ def test_damaged_cache_entries_are_rebuilt(tmp_path, monkeypatch):
     assert tmp_path.stat().st_mode & 0o077 == 0  # created private to the user
 
 
-def test_a_cache_folder_writable_by_others_is_refused(tmp_path, monkeypatch):
+def test_a_cache_folder_writable_by_others_is_not_used(tmp_path, monkeypatch):
+    """Issue 26: serialized functions are not read from, nor written to, a folder others
+    can write; the model is derived in a private temporary folder, with a warning."""
+    from derive.cache import UntrustedCache, ensure_private_dir
+
     folder = tmp_path / "shared"
     folder.mkdir(mode=0o777)
     folder.chmod(0o777)
     monkeypatch.setenv("SLOSH_CACHE_DIR", str(folder))
-    with pytest.raises(PermissionError, match="writable by other users"):
-        derive(_two_pendulum())
+    with pytest.warns(UntrustedCache, match="shared is writable by group or others"):
+        dm = derive(_two_pendulum())
+    assert not dm.from_cache and not list(folder.iterdir())
+    with pytest.raises(PermissionError, match="writable by group or others"):
+        ensure_private_dir(folder)
 
 
 def test_a_structure_is_kept_in_memory_per_thread_until_its_entry_changes(tmp_path,
