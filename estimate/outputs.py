@@ -36,6 +36,7 @@ import numpy as np
 
 from analogs.errors import InputError
 
+from .inputs import file_kind
 from .interrupts import deferred, temporary
 
 __all__ = ["NON_FINITE_KEY", "OutputError", "Outputs", "json_text"]
@@ -129,6 +130,11 @@ class Outputs:
             if it.names is None and it.path.is_dir():
                 problems.append(f"{where}: is a folder; expected a file name")
                 continue
+            special = [(p, kind) for p in self._finals(it) if (kind := _special(p))]
+            if special:
+                problems += [f"{it.option} {p}: is {kind}; expected a regular file (an output "
+                             "is renamed into place, which would replace it)" for p, kind in special]
+                continue
             existing += [str(p) for p in self._finals(it) if p.exists() or p.is_symlink()]
         seen: dict[Path, str] = {}
         for it in self._items:
@@ -196,6 +202,9 @@ class Outputs:
                 moves.append((tmp, it.path))
             else:
                 moves += [(f, it.path / f.name) for f in sorted(tmp.iterdir())]
+        special = [f"{final} is {kind}" for _, final in moves if (kind := _special(final))]
+        if special:  # appeared since the check
+            raise OutputError(f"{'; '.join(special)}; expected a regular file")
         unexpected = [str(final) for _, final in moves if final.exists() and not self.overwrite]
         if unexpected:
             raise OutputError(f"{', '.join(unexpected)} exist(s); pass --overwrite to replace")
@@ -226,6 +235,13 @@ class Outputs:
                 raise
         for backup, _ in backups:
             _remove(backup)
+
+
+def _special(path: Path) -> str | None:
+    """What an existing output target is when it is neither a regular file nor a folder
+    (a device such as ``/dev/full``, a pipe, a socket), else None."""
+    kind = file_kind(path)
+    return None if kind in (None, "a folder") else kind
 
 
 def _placeholder(final: Path, folder: bool) -> Path:

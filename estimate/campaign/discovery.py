@@ -26,7 +26,7 @@ from __future__ import annotations
 import fnmatch
 import glob
 import hashlib
-import tomllib
+import os
 from collections.abc import Mapping
 from dataclasses import dataclass
 from pathlib import Path
@@ -35,7 +35,9 @@ from typing import Any
 from analogs.errors import InputError
 
 from ..data.models import BASELINE
+from ..data.reader import MAX_CASE_FILE_BYTES
 from ..fitting.problem import INPUT_MODES
+from ..inputs import file_kind, load_toml, open_input
 
 __all__ = ["CAMPAIGN_FILE", "Campaign", "Group", "Record", "Setup", "discover"]
 
@@ -135,17 +137,19 @@ class Campaign:
 
 
 def _sha256(path: Path) -> str | None:
+    """SHA-256 of a regular file's bytes; None for anything else (a pipe or a device is
+    never opened for reading: loading the record says what it is)."""
     try:
-        with path.open("rb") as fh:
+        with open_input(path, "a data file") as fh:
             return hashlib.file_digest(fh, "sha256").hexdigest()
-    except OSError:
+    except (OSError, InputError):
         return None
 
 
 def _read_toml(path: Path) -> dict[str, Any] | None:
     try:
-        return tomllib.loads(path.read_bytes().decode("utf-8"))
-    except (OSError, UnicodeDecodeError, tomllib.TOMLDecodeError):
+        return load_toml(path, "a TOML case file", limit=MAX_CASE_FILE_BYTES)
+    except (OSError, InputError):
         return None
 
 
@@ -188,7 +192,7 @@ def _record(path: Path, root: Path) -> Record | None:
     if isinstance(data, str) and data.strip():
         data_sha = _sha256(path.parent / data)
         if data_sha is not None:
-            data_bytes = (path.parent / data).stat().st_size
+            data_bytes = os.stat(path.parent / data).st_size
     try:
         rel = path.resolve().relative_to(root).as_posix()
     except ValueError:
@@ -261,12 +265,11 @@ def _settings(path: Path, records: tuple[Record, ...]) -> tuple[dict[str, Any], 
                                                                  | None]:
     """``[campaign]`` settings and the explicit groups of ``campaign.toml`` (None: group by
     keys); every problem of the file is reported at once."""
-    if not path.is_file():
+    if not path.exists() and not path.is_symlink():
         return {}, None
-    try:
-        doc = tomllib.loads(path.read_text(encoding="utf-8"))
-    except (UnicodeDecodeError, tomllib.TOMLDecodeError) as err:
-        raise InputError(f"{path}: invalid TOML: {err}") from None
+    if file_kind(path):
+        raise InputError(f"{path}: expected the campaign file (TOML), found {file_kind(path)}")
+    doc = load_toml(path, "the campaign file (TOML)", limit=MAX_CASE_FILE_BYTES)
     fname, problems = path.name, []
     for key in sorted(set(doc) - {"campaign", "groups"}):
         problems.append(f"{fname}: unknown table `[{key}]` (known: [campaign], [groups.NAME])")

@@ -17,6 +17,7 @@ import tempfile
 from pathlib import Path
 from typing import Any
 
+from ..inputs import load_json
 from .discovery import Setup
 from .outliers import FAMILY_ERROR, MIN_RECORDS
 from .plots import amplitude_varies, plot_against_amplitude, plot_against_fill, plotted_quantities
@@ -205,8 +206,8 @@ def claim_folder(out: str | Path, source: str, *, overwrite: bool = False) -> bo
     """
     out, ident = Path(out), os.path.abspath(source)
     manifest = out / MANIFEST
-    try:
-        mine = json.loads(manifest.read_text()).get("source") == ident
+    try:  # read as any input: a pipe or a device in its place is not read
+        mine = load_json(manifest, "the campaign manifest", limit=2**20).get("source") == ident
     except (OSError, ValueError, AttributeError):
         mine = False
     existing = [str(out / n) for n in (*OUTPUTS, "store", MANIFEST) if (out / n).exists()]

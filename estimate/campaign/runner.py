@@ -3,9 +3,14 @@ outliers, on an executor, each result stored under the key of its inputs as it a
 
 Two stages: the records first, since a group is fitted without the records that disagree
 with it (:mod:`estimate.campaign.outliers`), which only the records' fits tell. Within a stage
-the longest tasks start first. A result already in the store is taken from it; an interrupted
-run loses only the tasks that were running. Cases are loaded here, only for tasks that run,
-and shipped to the workers, so a remote cluster needs no shared file system.
+the longest tasks start first. A result already in the store is taken from it (unless
+``recompute``) when it passes its checksum and the check of its layout
+(:func:`estimate.campaign.tasks.check_outcome`), else it is computed again with a warning.
+A failure is stored only when it depends on the inputs alone; one caused by the environment
+runs again next time. A record whose fit failed is left out of its group's fit, which uses
+the others. An interrupted run loses only the tasks that were running. Cases are loaded
+here, only for tasks that run, and shipped to the workers, so a remote cluster needs no
+shared file system.
 """
 
 from __future__ import annotations
@@ -26,7 +31,7 @@ from .discovery import Campaign, Record
 from .outliers import Outlier, find_outliers
 from .progress import Progress
 from .store import Store, task_key
-from .tasks import Task, run_task
+from .tasks import Task, check_outcome, run_task
 
 __all__ = ["CampaignRun", "run_campaign"]
 
@@ -71,9 +76,10 @@ def _one_line(text: str) -> str:
 
 
 class _Runner:
-    def __init__(self, campaign: Campaign, store: Store, executor: Executor, progress: Progress
-                 ) -> None:
+    def __init__(self, campaign: Campaign, store: Store, executor: Executor, progress: Progress,
+                 *, recompute: bool = False, strict: bool = False) -> None:
         self.campaign, self.store, self.executor, self.progress = campaign, store, executor, progress
+        self.recompute, self.strict = recompute, strict
         self.options = {"input": campaign.input}
         self.loaded: dict[str, Case | str] = {}      # record id -> case, or why it failed
         self.outcomes: dict[str, dict[str, Any]] = {}  # key -> outcome of this run
@@ -92,7 +98,7 @@ class _Runner:
     def load(self, record: Record) -> Case | str:
         if record.id not in self.loaded:
             try:
-                self.loaded[record.id] = load_case(record.path)
+                self.loaded[record.id] = load_case(record.path, strict=self.strict)
             except InputError as err:
                 self.loaded[record.id] = _one_line(err)
         return self.loaded[record.id]
@@ -109,7 +115,8 @@ class _Runner:
         for key, (kind, label, ids, model) in zip(keys, wanted):
             if key in tasks or key in self.outcomes:
                 continue
-            stored = self.store.get(key)
+            stored = None if self.recompute else self.store.get(
+                key, check=lambda outcome, kind=kind: check_outcome(kind, outcome))
             if stored is not None:
                 self.outcomes[key] = stored
                 self.reused += 1
@@ -118,7 +125,8 @@ class _Runner:
             cases = [self.load(self.campaign.record(i)) for i in ids]
             bad = [f"{i}: {c}" for i, c in zip(ids, cases) if isinstance(c, str)]
             if bad:    # not stored: loading again costs little and tells the same
-                self.outcomes[key] = {"status": "failed", "error": "; ".join(bad), "stage": "load"}
+                self.outcomes[key] = {"status": "failed", "error": "; ".join(bad), "stage": "load",
+                                      "failure": "inputs"}
                 self.failed += 1
                 self.progress.submit(1)
                 self.progress.finish(False, 0.0, self.work[key])
@@ -145,10 +153,10 @@ class _Runner:
                 try:
                     outcome = future.result()
                 except Exception as err:  # noqa: BLE001 - a worker died: retried next run
-                    outcome = {"status": "failed", "retry": True,
+                    outcome = {"status": "failed", "failure": "environment",
                                "error": _one_line(f"{type(err).__name__}: {err}"), "seconds": 0.0}
                 seconds = float(outcome.pop("seconds", 0.0))
-                if not outcome.pop("retry", False):
+                if outcome["status"] != "failed" or outcome.get("failure") == "inputs":
                     self.store.put(task.key, outcome, seconds=seconds)
                 self.outcomes[task.key] = outcome
                 self.computed += 1
@@ -157,7 +165,8 @@ class _Runner:
 
 
 def run_campaign(campaign: Campaign, out: str | Path, *, executor: Executor | None = None,
-                 diagnose: bool = False, progress: bool | None = None) -> CampaignRun:
+                 diagnose: bool = False, progress: bool | None = None, recompute: bool = False,
+                 strict: bool = False) -> CampaignRun:
     """Fit (and diagnose) every record of ``campaign``, then each group without its outliers.
 
     Parameters
@@ -172,6 +181,10 @@ def run_campaign(campaign: Campaign, out: str | Path, *, executor: Executor | No
         Also diagnose every record (:func:`estimate.diagnosis.diagnose`).
     progress : bool, optional
         Show campaign progress on stderr; default when stderr is a terminal.
+    recompute : bool, default False
+        Compute every task again (``--overwrite``) instead of taking stored results.
+    strict : bool, default False
+        Refuse case files with unknown keys (``--strict``) instead of warning.
 
     Returns
     -------
@@ -184,7 +197,8 @@ def run_campaign(campaign: Campaign, out: str | Path, *, executor: Executor | No
     t0 = time.perf_counter()
     executor = executor or LocalExecutor()
     bar = Progress(executor.workers, enabled=progress)
-    runner = _Runner(campaign, Store(Path(out) / "store"), executor, bar)
+    runner = _Runner(campaign, Store(Path(out) / "store"), executor, bar, recompute=recompute,
+                     strict=strict)
     ids = [r.id for r in campaign.records]
     try:
         # the groups' fits come once the records' are known; count them from the start
@@ -201,9 +215,10 @@ def run_campaign(campaign: Campaign, out: str | Path, *, executor: Executor | No
         flagged = {o.record for o in outliers}
         groups, excluded = [], {}
         for g in campaign.groups:
-            excluded[g.name] = {i: ("outlier" if i in flagged else "failed to load")
+            excluded[g.name] = {i: ("outlier" if i in flagged else "failed to load"
+                                    if records[i].get("stage") == "load" else "its fit failed")
                                 for i in g.records if i in flagged
-                                or records[i].get("stage") == "load"}
+                                or records[i].get("status") == "failed"}
             members = tuple(i for i in g.records if i not in excluded[g.name])
             if members:
                 groups.append((g.name, ("fit", f"group {g.name}", members, g.model)))
@@ -215,7 +230,8 @@ def run_campaign(campaign: Campaign, out: str | Path, *, executor: Executor | No
     for g in campaign.groups:
         wanted = next((w for name, w in groups if name == g.name), None)
         outcome = dict(fitted[runner._key(*wanted)]) if wanted else {
-            "status": "failed", "error": "no record of the group can be fitted"}
+            "status": "failed", "error": "no record of the group can be fitted",
+            "failure": "inputs"}
         outcome["members"] = list(wanted[2]) if wanted else []
         outcome["excluded"] = excluded[g.name]
         group_out[g.name] = outcome

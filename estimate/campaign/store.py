@@ -8,7 +8,11 @@ inputs have not changed and computes the others.
 
 Entries are written to a hidden temporary file in the store folder and renamed into place,
 so a reader never sees a partial entry; an interrupted run leaves at most hidden ``.tmp``
-files, which are ignored. An entry that cannot be read is computed again.
+files, which are ignored. Each entry holds the SHA-256 of its outcome, and is read as any
+input is (a regular file within :data:`MAX_ENTRY_BYTES`, :func:`estimate.inputs.load_json`):
+an entry that cannot be read, is not a JSON object of this layout, names another key, fails
+its checksum (an edited value) or fails the caller's check of the outcome is computed again,
+with a warning naming the file and what is wrong.
 """
 
 from __future__ import annotations
@@ -18,14 +22,27 @@ import json
 import os
 import tempfile
 import warnings
-from collections.abc import Mapping, Sequence
+from collections.abc import Callable, Mapping, Sequence
 from pathlib import Path
 from typing import Any
 
-__all__ = ["STORE_SCHEMA", "Store", "package_version", "task_key", "write_atomic"]
+from analogs.errors import InputError
+
+from ..inputs import load_json
+
+__all__ = ["MAX_ENTRY_BYTES", "STORE_SCHEMA", "Store", "outcome_checksum", "package_version",
+           "task_key", "write_atomic"]
 
 #: Version of the key and entry layout; raising it invalidates every stored result.
-STORE_SCHEMA = 1
+STORE_SCHEMA = 2
+#: Largest store entry read [bytes] (an outcome is a few kilobytes).
+MAX_ENTRY_BYTES = 16 * 2**20
+
+
+def outcome_checksum(outcome: Mapping[str, Any]) -> str:
+    """SHA-256 of an outcome's canonical JSON (sorted keys; NaN written as ``NaN``)."""
+    text = json.dumps(outcome, sort_keys=True, separators=(",", ":"), allow_nan=True)
+    return hashlib.sha256(text.encode()).hexdigest()
 
 
 def package_version() -> str:
@@ -93,32 +110,55 @@ class Store:
     def _path(self, key: str) -> Path:
         return self.folder / f"{key}.json"
 
-    def get(self, key: str) -> dict[str, Any] | None:
-        """The stored outcome of ``key``, or None (absent or unreadable: recompute)."""
+    def _entry(self, key: str) -> dict[str, Any]:
+        """The entry of ``key`` checked for layout, key and checksum; raises ValueError (or
+        InputError, OSError) saying what is wrong."""
+        entry = load_json(self._path(key), "a campaign store entry", limit=MAX_ENTRY_BYTES)
+        if not isinstance(entry, dict):
+            raise ValueError(f"expected a JSON object, found {type(entry).__name__}")
+        if entry.get("key") != key:
+            raise ValueError("the entry names another key")
+        if entry.get("schema") != STORE_SCHEMA:
+            raise ValueError(f"layout {entry.get('schema')!r}, expected {STORE_SCHEMA}")
+        outcome = entry.get("outcome")
+        if not isinstance(outcome, dict) or not outcome:
+            raise ValueError(f"expected an outcome object, found {outcome!r}"[:200])
+        if entry.get("sha256") != outcome_checksum(outcome):
+            raise ValueError("the outcome does not match its checksum (edited or damaged)")
+        return entry
+
+    def get(self, key: str, check: Callable[[dict[str, Any]], str | None] | None = None
+            ) -> dict[str, Any] | None:
+        """The stored outcome of ``key``, or None (absent, or damaged: recompute).
+
+        ``check(outcome)`` says what is wrong with an outcome that passed its checksum (None:
+        nothing); a damaged entry is reported with a :class:`RuntimeWarning` naming it."""
         path = self._path(key)
-        if not path.is_file():
+        if not path.exists() and not path.is_symlink():
             return None
         try:
-            entry = json.loads(path.read_text())
-            if entry.get("key") != key:
-                raise ValueError("the entry names another key")
-            return entry["outcome"]
-        except (OSError, ValueError, KeyError, TypeError) as err:
+            outcome = self._entry(key)["outcome"]
+            why = check(outcome) if check is not None else None
+            if why:
+                raise ValueError(why)
+            return outcome
+        except (OSError, ValueError, InputError) as err:
             warnings.warn(f"campaign store entry {path} is damaged ({err}); computing it again",
                           RuntimeWarning, stacklevel=2)
             return None
 
     def put(self, key: str, outcome: Mapping[str, Any], *, seconds: float = 0.0) -> Path:
-        """Store ``outcome`` (JSON values; floats round-trip exactly) under ``key``;
-        ``seconds`` is kept beside it for timing, not for results."""
-        entry = {"key": key, "schema": STORE_SCHEMA, "seconds": seconds, "outcome": outcome}
+        """Store ``outcome`` (JSON values; floats round-trip exactly) under ``key`` with its
+        checksum; ``seconds`` is kept beside it for timing, not for results."""
+        entry = {"key": key, "schema": STORE_SCHEMA, "seconds": seconds, "outcome": outcome,
+                 "sha256": outcome_checksum(outcome)}
         return write_atomic(self._path(key), json.dumps(entry, indent=1, allow_nan=True).encode())
 
     def seconds(self, key: str) -> float | None:
         """How long the stored task took (s), or None."""
         try:
-            return float(json.loads(self._path(key).read_text())["seconds"])
-        except (OSError, ValueError, KeyError, TypeError):
+            return float(self._entry(key)["seconds"])
+        except (OSError, ValueError, KeyError, TypeError, InputError):
             return None
 
     def keys(self) -> set[str]:

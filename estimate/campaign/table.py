@@ -100,8 +100,18 @@ def _setup_cells(setup) -> dict[str, Any]:
             "liquid_viscosity [m^2/s]": setup.viscosity}
 
 
+def _error_cell(outcome: dict[str, Any]) -> str:
+    """The error of a failed outcome with whether it is retried (:data:`FAILURE_CAUSES`)."""
+    from .tasks import FAILURE_CAUSES
+
+    error = outcome.get("error") or ""
+    cause = FAILURE_CAUSES.get(outcome.get("failure")) if outcome.get("status") == "failed" \
+        else None
+    return f"{error} [{cause}]" if error and cause else error
+
+
 def _fit_cells(outcome: dict[str, Any], units: dict[str, str]) -> dict[str, Any]:
-    out: dict[str, Any] = {"status": outcome.get("status"), "error": outcome.get("error") or "",
+    out: dict[str, Any] = {"status": outcome.get("status"), "error": _error_cell(outcome),
                            "model": outcome.get("model") or "",
                            "iterations": outcome.get("iterations"),
                            "samples": outcome.get("samples")}

@@ -17,7 +17,14 @@ from analogs.errors import InputError
 
 from ..data.case import Case
 
-__all__ = ["Task", "drive_amplitude", "run_task"]
+__all__ = ["FAILURE_CAUSES", "Task", "check_outcome", "drive_amplitude", "run_task"]
+
+#: Why a task failed, as its outcome's ``failure`` says: ``"inputs"`` (the case files, data
+#: or model: stored, and not retried until they change) or ``"environment"`` (the machine,
+#: a library, a worker: not stored, retried on the next run).
+FAILURE_CAUSES = {"inputs": "depends only on the inputs: kept until they change",
+                  "environment": "not caused by the inputs: retried on the next run"}
+_STATUSES = ("ok", "not_converged", "failed")
 
 #: Level of the intervals in the campaign table (the fit report's 95 %).
 LEVEL = 0.95
@@ -138,20 +145,68 @@ def run_task(task: Task, shared: Any = None) -> dict[str, Any]:
     """Run ``task`` and return its outcome: ``status`` (``"ok"``, ``"not_converged"`` or
     ``"failed"``), ``error`` (None or one line), ``seconds`` and the task's results.
 
-    An error of the task itself (a bad model specification, a case the model cannot fit,
-    a solver failure) is returned as ``status = "failed"`` and stored like a result;
-    ``retry = True`` marks failures of the machine (out of memory), which are not stored.
-    ``shared`` is unused (the executor interface passes it).
+    A failure says its cause in ``failure`` (:data:`FAILURE_CAUSES`): an error in what the
+    user gave (:class:`~analogs.errors.InputError`: a bad model specification, a case the
+    model cannot fit) depends only on the inputs and is stored like a result; anything else
+    (out of memory, a file-system error, a missing library, a solver crash) is the
+    environment's, is not stored and runs again next time. ``shared`` is unused (the
+    executor interface passes it).
     """
     t0 = time.perf_counter()
     try:
         task = dataclasses.replace(task, cases=tuple(_own_arrays(c) for c in task.cases))
         outcome = _fit(task) if task.kind == "fit" else _diagnosis(task)
     except InputError as err:
-        outcome = {"status": "failed", "error": str(err).replace("\n", " ")}
+        outcome = {"status": "failed", "error": str(err).replace("\n", " "), "failure": "inputs"}
     except MemoryError as err:
-        outcome = {"status": "failed", "error": f"out of memory: {err}", "retry": True}
+        outcome = {"status": "failed", "error": f"out of memory: {err}", "failure": "environment"}
     except Exception as err:  # noqa: BLE001 - reported in the table, the others go on
-        outcome = {"status": "failed", "error": f"{type(err).__name__}: {err}".replace("\n", " ")}
+        outcome = {"status": "failed", "error": f"{type(err).__name__}: {err}".replace("\n", " "),
+                   "failure": "environment"}
     outcome["seconds"] = time.perf_counter() - t0
     return outcome
+
+
+def _numbers(value: Any) -> bool:
+    return isinstance(value, (int, float)) and not isinstance(value, bool)
+
+
+def _quantity_rows(table: Any) -> bool:
+    return isinstance(table, dict) and all(
+        isinstance(k, str) and isinstance(v, list) and len(v) == 5
+        and all(_numbers(x) for x in v[:4]) and isinstance(v[4], str) for k, v in table.items())
+
+
+def check_outcome(kind: str, outcome: dict[str, Any]) -> str | None:
+    """What is wrong with a stored outcome of a ``kind`` task (None: it has the layout
+    :func:`run_task` writes): a status, an error line, and the results of its kind."""
+    status = outcome.get("status")
+    if status not in _STATUSES:
+        return f"`status`: expected one of {', '.join(_STATUSES)}, found {status!r}"
+    error = outcome.get("error")
+    if error is not None and not isinstance(error, str):
+        return f"`error`: expected a line of text or null, found {error!r}"
+    if status == "failed":
+        if not error:
+            return "a failed outcome without its error"
+        if outcome.get("failure") != "inputs":
+            return "a stored failure that does not depend only on the inputs"
+        return None
+    cases = outcome.get("cases")
+    if not (isinstance(cases, list) and cases and all(isinstance(c, str) for c in cases)):
+        return f"`cases`: expected a list of record ids, found {cases!r}"
+    if kind == "fit":
+        if not (_quantity_rows(outcome.get("parameters")) and outcome["parameters"]):
+            return "`parameters`: expected estimates as [value, stderr, lo, hi, unit]"
+        if not _quantity_rows(outcome.get("derived")):
+            return "`derived`: expected quantities as [value, stderr, lo, hi, unit]"
+        for key in ("rms_residual", "noise", "samples", "iterations"):
+            if not _numbers(outcome.get(key)):
+                return f"`{key}`: expected a number, found {outcome.get(key)!r}"
+        if not isinstance(outcome.get("records"), dict):
+            return "`records`: expected an object by record id"
+    else:
+        if not isinstance(outcome.get("verdict"), str) or not isinstance(
+                outcome.get("findings"), list):
+            return "expected a diagnosis with `verdict` and `findings`"
+    return None

@@ -8,6 +8,8 @@ import sys
 
 from analogs.errors import InputError
 
+from ._cases import add_strict
+
 __all__ = ["add_parser", "run"]
 
 
@@ -37,7 +39,9 @@ def add_parser(sub: argparse._SubParsersAction) -> None:
     where.add_argument("--threads", metavar="N", type=int, default=None,
                        help="threads of the local executor (default: the CPU count)")
     p.add_argument("--overwrite", action="store_true",
-                   help="write into an output folder that belongs to another campaign")
+                   help="compute every result again instead of taking it from the store, and "
+                        "write into an output folder that belongs to another campaign")
+    add_strict(p)
     p.set_defaults(run=run)
 
 
@@ -64,7 +68,8 @@ def run(args: argparse.Namespace) -> int:
           + (", resuming" if resumed else ""))
     try:
         with _executor(args) as executor:
-            result = run_campaign(campaign, args.out, executor=executor, diagnose=args.diagnose)
+            result = run_campaign(campaign, args.out, executor=executor, diagnose=args.diagnose,
+                                  recompute=args.overwrite, strict=args.strict)
     except KeyboardInterrupt:
         print(f"\ninterrupted: finished results are kept in {args.out}/store; run the same "
               "command again to resume", file=sys.stderr)

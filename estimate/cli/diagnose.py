@@ -5,7 +5,7 @@ from __future__ import annotations
 import argparse
 
 from ..outputs import Outputs, json_text
-from ._cases import load_cases
+from ._cases import add_strict, load_cases
 
 __all__ = ["add_parser"]
 
@@ -21,6 +21,7 @@ def add_parser(sub: argparse._SubParsersAction) -> None:
     p.add_argument("--json", dest="json_out", required=True, help="write the diagnosis as JSON")
     p.add_argument("--report", default=None, help="write the report folder (plots, Markdown)")
     p.add_argument("--overwrite", action="store_true", help="replace existing output files")
+    add_strict(p)
     p.set_defaults(run=run)
 
 
@@ -32,7 +33,7 @@ def run(args: argparse.Namespace) -> int:
 
     outputs = Outputs(overwrite=args.overwrite, inputs=args.cases)
     outputs.file("--json", args.json_out).folder("--report", args.report, REPORT_FILES).check()
-    cases, notes = load_cases(args.cases, prediction=True)
+    cases, notes = load_cases(args.cases, prediction=True, strict=args.strict)
     for w in notes:
         print(f"warning: {w}", file=sys.stderr)
     d = diagnose(cases)

@@ -5,7 +5,7 @@ from __future__ import annotations
 import argparse
 
 from ..outputs import Outputs, json_text
-from ._cases import load_cases
+from ._cases import add_strict, load_cases
 
 __all__ = ["add_parser"]
 
@@ -35,6 +35,7 @@ def add_parser(sub: argparse._SubParsersAction) -> None:
     p.add_argument("--plot", default=None, help="write the fit plots (PNG) of the first case")
     p.add_argument("--report", action="store_true", help="print the full text fit report")
     p.add_argument("--overwrite", action="store_true", help="replace existing output files")
+    add_strict(p)
     p.set_defaults(run=run)
 
 
@@ -49,7 +50,7 @@ def run(args: argparse.Namespace) -> int:
 
     outputs = Outputs(overwrite=args.overwrite, inputs=args.cases)
     outputs.file("--json", args.json_out).file("--plot", args.plot).check()
-    cases, notes = load_cases(args.cases, prediction=True)
+    cases, notes = load_cases(args.cases, prediction=True, strict=args.strict)
     for w in notes:  # before the fit, which starts from [prediction]
         print(f"warning: {w}", file=sys.stderr)
     spec = BASELINE if args.model is None else args.model

@@ -12,6 +12,7 @@ from pathlib import Path
 from analogs.errors import InputError
 
 from ..outputs import Outputs, json_text
+from ._cases import add_strict
 
 __all__ = ["add_parser", "run"]
 
@@ -40,6 +41,7 @@ def add_parser(subparsers: argparse._SubParsersAction) -> None:
     p.add_argument("--out", metavar="DIR", default="montecarlo",
                    help="output folder for montecarlo.json and envelope.png (default ./montecarlo)")
     p.add_argument("--overwrite", action="store_true", help="replace existing output files")
+    add_strict(p)
     p.set_defaults(run=run)
 
 
@@ -60,7 +62,7 @@ def run(args: argparse.Namespace) -> int:
         outputs.file(f"--out {name}", path, new_folder=True)
     outputs.check()
     fit = read_fit(args.fit)
-    case = load_case(args.case)
+    case = load_case(args.case, strict=args.strict)
     exp = experiment(case, model_from_spec(args.model or fit.model_spec, case))
     with executor_for(args.scheduler, local=args.local, n_workers=args.workers) as ex:
         res = monte_carlo(exp.derived, case.time, exp.excitation, fit, args.samples,

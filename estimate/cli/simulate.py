@@ -8,6 +8,7 @@ import sys
 from analogs.errors import InputError
 
 from ..outputs import Outputs
+from ._cases import add_strict
 
 __all__ = ["add_parser"]
 
@@ -30,6 +31,7 @@ def add_parser(sub: argparse._SubParsersAction) -> None:
     p.add_argument("--integrator", choices=("rk4", "adaptive"), default="rk4",
                    help="fixed-step RK4 on the sample grid (default) or CVODES")
     p.add_argument("--overwrite", action="store_true", help="replace an existing --out file")
+    add_strict(p)
     p.set_defaults(run=run)
 
 
@@ -45,7 +47,7 @@ def run(args: argparse.Namespace) -> int:
 
     outputs = Outputs(overwrite=args.overwrite, inputs=[args.case, args.params])
     outputs.file("--out", args.out).check()
-    case = load_case(args.case)
+    case = load_case(args.case, strict=args.strict)
     params = read_params(args.params)
     x0 = fitted_initial_state(args.params, case) if case.test.initial_state == "free" else None
     exp = experiment(case, model_from_spec(BASELINE if args.model is None else args.model, case))

@@ -3,12 +3,16 @@
 from __future__ import annotations
 
 import csv
+import io
 from collections.abc import Iterator
 from pathlib import Path
 from typing import Any
 
 import numpy as np
 
+from analogs.errors import InputError
+
+from ..inputs import open_input
 from ._samples import MAX_LISTED_ROWS as _MAX_LISTED_ROWS
 from ._samples import check_samples, rows_text
 from .budget import decimation_hint, max_samples
@@ -35,7 +39,7 @@ def _count_lines(path: Path) -> int:
     its rows unless line ends are mixed)."""
     lf = cr = 0
     last = b"\n"
-    with path.open("rb") as fh:
+    with open_input(path, "a CSV file") as fh:
         while chunk := fh.read(2**20):
             lf += chunk.count(b"\n")
             cr += chunk.count(b"\r")
@@ -64,8 +68,12 @@ def read_csv(path: Path, excitation: str | None, problems: list[str],
         if n_lines - 1 > max_samples():
             problems.append(f"{name}: rows: {n_lines - 1} samples; {decimation_hint(n_lines - 1)}")
             return None
-        with path.open("r", newline="", encoding="utf-8-sig") as fh:
+        with io.TextIOWrapper(open_input(path, "a CSV file"), newline="",
+                              encoding="utf-8-sig") as fh:
             return _read_rows(csv.reader(fh), n_lines, name, excitation, problems, rig_kind)
+    except InputError as exc:  # replaced by a pipe or a device since it was checked
+        problems.append(f"{name}: {str(exc).split(': ', 1)[-1]}")
+        return None
     except OSError as exc:
         problems.append(f"{name}: cannot read the CSV file ({exc.strerror or exc})")
         return None

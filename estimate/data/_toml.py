@@ -11,6 +11,7 @@ from .case import (
     KNOWN_INITIAL_STATES,
     KNOWN_RIGS,
     KNOWN_SHAPES,
+    PHYSICAL_RANGES,
     SPIN_COLUMN_KEYS,
     TANK_AXES,
     Crank,
@@ -22,7 +23,7 @@ from .case import (
     TestInfo,
 )
 
-__all__ = ["Checker", "read_tables", "test_kind"]
+__all__ = ["Checker", "range_problem", "read_tables", "test_kind"]
 
 
 class Checker:
@@ -102,12 +103,30 @@ class Checker:
         if open_unit_interval and not 0.0 < number < 1.0:
             self.add(where, f"expected a number strictly between 0 and 1, found {value!r}")
             return None
+        why = range_problem(number, unit, positive=positive)
+        if why:
+            self.add(where, f"{why}, found {value!r}")
+            return None
         return number
+
+
+def range_problem(value: float, unit: str, *, positive: bool = False) -> str | None:
+    """What a value of ``unit`` outside :data:`~estimate.data.case.PHYSICAL_RANGES` should
+    have been (None: inside, or a unit without a range)."""
+    if unit not in PHYSICAL_RANGES:
+        return None
+    low, high, what = PHYSICAL_RANGES[unit]
+    if abs(value) > high or (positive and value < low):
+        span = f"{low:g} to {high:g}" if positive else f"a magnitude up to {high:g}"
+        return f"expected {span} {unit} (the range accepted for a {what})"
+    return None
 
 
 def _type_name(value: Any) -> str:
     names = {bool: "a boolean", int: "an integer", float: "a float", str: "a string",
              list: "an array", dict: "a table"}
+    if isinstance(value, Mapping):
+        return "a table"
     return names.get(type(value), type(value).__name__)
 
 

@@ -36,7 +36,8 @@ CSV file with the measured samples. The format is the one of the estimation issu
     damping_ratio = 0.00703      # fraction of critical
 
 The CSV header is ``time,displacement,force`` (s, m, N); ``displacement`` may be absent when
-``excitation = "crank"``. Keys not listed above are allowed and ignored (``[test] note`` is kept).
+``excitation = "crank"``. Keys not listed above are reported with the nearest known name
+(a warning, an error under ``--strict``) and otherwise ignored (``[test] note`` is kept).
 
 Spinning rig
 ------------
@@ -118,6 +119,7 @@ __all__ = [
     "KNOWN_SHAPES",
     "MIN_DURATION",
     "MIN_SAMPLES",
+    "PHYSICAL_RANGES",
     "TIME_STEP_RTOL",
     "Case",
     "CaseError",
@@ -154,6 +156,26 @@ MIN_DURATION: float = 0.1
 """Shortest record [s] (see the module docstring for why)."""
 TIME_STEP_RTOL: float = 1e-3
 """Allowed deviation of each time step from the median step, relative to the median step."""
+PHYSICAL_RANGES: dict[str, tuple[float, float, str]] = {
+    "kg": (1e-6, 1e6, "mass"),
+    "m": (1e-6, 1e3, "length"),
+    "m/s^2": (1e-6, 1e3, "acceleration"),
+    "kg/m^3": (1e-3, 1e5, "density"),
+    "m^2/s": (1e-12, 1.0, "kinematic viscosity"),
+    "Hz": (1e-6, 1e3, "frequency"),
+    "rad/s": (1e-6, 1e3, "rate"),
+    "s": (1e-6, 1e6, "duration"),
+    "- (fraction of critical)": (0.0, 10.0, "damping ratio"),
+    "N": (0.0, 1e9, "force"),
+    "N m": (0.0, 1e9, "torque"),
+    "kg m^2": (1e-12, 1e9, "moment of inertia"),
+}
+"""Values accepted for a number of each unit in a case or spacecraft file: (smallest
+positive value, largest magnitude, what it is). Wide enough for any tank test or spacecraft
+(a milligram to a thousand tonnes, a micrometre to a kilometre, up to 1000 rad/s), narrow
+enough that products and squares of them stay finite in double precision, and a value in
+the wrong unit or with a slipped exponent (``dry_mass = 1e30``) is refused before any
+computation; the smallest value applies to quantities that must be positive."""
 
 
 

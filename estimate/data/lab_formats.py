@@ -53,6 +53,7 @@ import numpy as np
 
 from analogs.errors import MissingDependency
 
+from ..inputs import open_input
 from ._samples import check_samples, rows_text
 from .budget import decimation_hint, max_samples
 from .case import SPINNING_CHANNELS, Rig
@@ -254,7 +255,7 @@ def _decode(value: Any) -> str | None:
 
 def _tdms_channels(path: Path, stack) -> tuple[dict[str, _Channel], list[str]]:
     nptdms = _require("nptdms", "npTDMS", path.name)
-    with path.open("rb") as fh:
+    with open_input(path, "a TDMS file") as fh:
         lead_in = fh.read(4)
     if lead_in != b"TDSm":  # npTDMS reads a file without it as one without channels
         raise ValueError(f"expected a TDMS lead-in `TDSm`, found {lead_in!r}")
@@ -308,7 +309,7 @@ def _mat_channels(path: Path, stack) -> tuple[dict[str, _Channel], list[str]]:
     import scipy.io
     from scipy.io.matlab import matfile_version
 
-    with path.open("rb") as fh:
+    with open_input(path, "a MAT file") as fh:
         major, _ = matfile_version(fh)
     if major == 2:  # v7.3: HDF5 with a MATLAB header
         return _h5_channels(path, stack, mat=True)

@@ -4,17 +4,20 @@ file read by :mod:`estimate.data.lab_formats`), validated at once."""
 from __future__ import annotations
 
 import os
-import stat
-import tomllib
+import warnings
 from collections.abc import Mapping
 from pathlib import Path
 
+from analogs.errors import InputError
+
+from ..inputs import file_kind, parse_toml, read_input
 from ._csv import read_csv
+from ._keys import Asked, UnknownKey, unknown_keys
 from ._toml import Checker, read_tables, test_kind
 from .case import Case, CaseError
 from .lab_formats import LAB_SUFFIXES, is_lab_file, read_lab
 
-__all__ = ["MAX_CASE_FILE_BYTES", "load_case"]
+__all__ = ["MAX_CASE_FILE_BYTES", "UnknownKey", "load_case"]
 
 #: Largest case file read [bytes]: a case file holds a few short tables, the samples are
 #: in its CSV.
@@ -22,25 +25,27 @@ MAX_CASE_FILE_BYTES = 2**20
 
 
 def _not_a_file(path: Path) -> str | None:
-    """What ``path`` is when it exists and is not a regular file ("a folder", ...)."""
-    try:
-        mode = path.stat().st_mode
-    except FileNotFoundError:
-        return None
-    except (OSError, ValueError) as exc:  # ValueError: a NUL character in the path
-        return f"a path that cannot be read ({getattr(exc, 'strerror', None) or exc})"
-    if stat.S_ISREG(mode):
-        return None
-    return "a folder" if stat.S_ISDIR(mode) else "a special file (not a regular file)"
+    """What ``path`` is when it exists and is not a regular file ("a folder", "a named pipe
+    (FIFO)", ...)."""
+    return file_kind(path)
 
 
-def load_case(path: str | os.PathLike[str]) -> Case:
+def load_case(path: str | os.PathLike[str], *, strict: bool = False) -> Case:
     """Load and validate a test case (TOML file plus the CSV, TDMS, MAT or HDF5 file it names).
+
+    The case file must be a regular file of at most :data:`MAX_CASE_FILE_BYTES` bytes nested
+    at most :data:`estimate.inputs.MAX_NESTING` levels; numbers must lie in
+    :data:`~estimate.data.case.PHYSICAL_RANGES`. A key or table the reader does not know (a
+    typo such as ``[predicton]``) is reported with the nearest known name
+    (:mod:`estimate.data._keys`): a :class:`UnknownKey` warning, or a problem with
+    ``strict``.
 
     Parameters
     ----------
     path : str or path-like
         The TOML case file.
+    strict : bool, default False
+        Unknown keys and tables are errors instead of warnings (``--strict``).
 
     Returns
     -------
@@ -69,25 +74,24 @@ def load_case(path: str | os.PathLike[str]) -> Case:
         kind = _not_a_file(toml_path)
         if kind:
             raise CaseError([f"{fname}: expected a TOML case file at `{toml_path}`, found {kind}"])
-        size = toml_path.stat().st_size
-        if size > MAX_CASE_FILE_BYTES:
-            raise CaseError([f"{fname}: {size} bytes; a case file holds a few short tables "
-                             f"(at most {MAX_CASE_FILE_BYTES} bytes) and names its CSV in "
-                             "[test] data"])
-        raw = toml_path.read_bytes()
+        raw = read_input(toml_path, "a TOML case file", limit=MAX_CASE_FILE_BYTES)
     except FileNotFoundError:
         raise CaseError([f"{fname}: case file not found (expected a TOML file at "
                          f"`{toml_path}`)"]) from None
     except OSError as exc:
         raise CaseError([f"{fname}: cannot read the case file ({exc.strerror or exc})"]) from None
+    except CaseError:
+        raise
+    except InputError as exc:
+        raise CaseError([f"{fname}: {str(exc).split(': ', 1)[-1]}; a case file holds a few "
+                         "short tables and names its data file in [test] data"]) from None
     try:
-        doc = tomllib.loads(raw.decode("utf-8-sig"))  # a byte order mark is accepted
-    except UnicodeDecodeError as exc:
-        raise CaseError([f"{fname}: expected a UTF-8 TOML file, found undecodable bytes "
-                         f"({exc})"]) from None
-    except tomllib.TOMLDecodeError as exc:
-        raise CaseError([f"{fname}: invalid TOML: {exc}"]) from None
+        doc = parse_toml(raw, fname)  # a byte order mark is accepted
+    except InputError as exc:
+        raise CaseError([str(exc)]) from None
 
+    doc = Asked(doc)
+    doc.get("data")  # [data] belongs to lab files; a CSV case with one is refused below
     ck = Checker(fname)
     test, tank, liquid, rig, pred_present, prediction = read_tables(ck, doc)
     excitation, rig_kind = test_kind(doc)
@@ -126,8 +130,13 @@ def load_case(path: str | os.PathLike[str]) -> Case:
 
                 problems.extend(spin_column_problems(fname, rig.spin, arrays[3], arrays[0]))
 
-    if problems:
-        raise CaseError(problems)
+    unknown = unknown_keys(doc, fname, ignored=not strict)
+    if strict and unknown:
+        raise CaseError(problems + unknown)
+    if problems:  # a likely typo may explain a missing key
+        raise CaseError(problems + [u for u in unknown if "did you mean" in u])
+    for line in unknown:
+        warnings.warn(line, UnknownKey, stacklevel=2)
     assert test is not None and tank is not None and liquid is not None and rig is not None
     assert arrays is not None and data_path is not None
     assert not (pred_present and prediction is None)

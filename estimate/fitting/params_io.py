@@ -2,7 +2,6 @@
 
 from __future__ import annotations
 
-import json
 import math
 from collections.abc import Mapping
 from dataclasses import dataclass, field
@@ -17,14 +16,11 @@ __all__ = ["Fit", "read_fit", "read_params", "read_json", "fitted_initial_state"
 
 
 def read_json(path: str | Path, what: str) -> object:
-    """JSON content of ``path``; errors name the file and say what it should be."""
-    path = Path(path)
-    try:
-        return json.loads(path.read_text())
-    except FileNotFoundError:
-        raise FileNotFoundError(f"{what} {path} does not exist") from None
-    except json.JSONDecodeError as err:
-        raise InputError(f"{path}: not valid JSON ({err})") from None
+    """JSON content of ``path``; errors name the file and say what it should be (a regular
+    file within :data:`estimate.inputs.MAX_JSON_BYTES` bytes: :func:`estimate.inputs.load_json`)."""
+    from ..inputs import load_json
+
+    return load_json(path, f"a {what} (JSON)")
 
 
 def read_params(path: str | Path) -> dict[str, float]:
