@@ -8,6 +8,7 @@ from __future__ import annotations
 
 import argparse
 import math
+import sys
 from pathlib import Path
 from types import SimpleNamespace
 
@@ -51,6 +52,9 @@ def add_parser(subparsers: argparse._SubParsersAction) -> None:
                    help="FMU: largest internal RK4 step, s (default 0.01)")
     p.add_argument("--no-build", action="store_true", help="do not compile the C driver")
     p.add_argument("--overwrite", action="store_true", help="replace existing output files")
+    p.add_argument("--force", action="store_true",
+                   help="use a fit result that did not converge (`converged: false`), with a "
+                        "warning; refused without it")
     p.set_defaults(run=run)
 
 
@@ -114,7 +118,7 @@ def run(args: argparse.Namespace) -> int:
     from derive.export_c import c_export_files, export_c, has_c_compiler
 
     from ..data.models import BASELINE
-    from ..fitting.params_io import read_params
+    from ..fitting.params_io import fit_notes, read_params
 
     if not args.out and not args.fmu:
         raise InputError("nothing to write: give `--out DIR` for C sources and/or `--fmu OUT.fmu`")
@@ -127,6 +131,8 @@ def run(args: argparse.Namespace) -> int:
         raise InputError(f"--fmu {args.fmu}: an FMU holds a compiled binary and no C compiler was "
                          "found (install gcc, or set CC to one); `--out DIR` writes the C "
                          "sources without one")
+    for note in fit_notes(args.fit, force=args.force, what="parameter file"):
+        print(f"warning: {note}", file=sys.stderr)
     values = read_params(args.fit) | _assignments(args.set)
     spec = args.model or _spec_of(Path(args.fit)) or BASELINE
     outputs = Outputs(overwrite=args.overwrite, inputs=[args.fit])

@@ -7,6 +7,7 @@ Wire-up: ``estimate.cli`` calls :func:`add_parser` on its subparsers and dispatc
 from __future__ import annotations
 
 import argparse
+import sys
 from pathlib import Path
 
 from analogs.errors import InputError
@@ -41,6 +42,9 @@ def add_parser(subparsers: argparse._SubParsersAction) -> None:
     p.add_argument("--out", metavar="DIR", default="montecarlo",
                    help="output folder for montecarlo.json and envelope.png (default ./montecarlo)")
     p.add_argument("--overwrite", action="store_true", help="replace existing output files")
+    p.add_argument("--force", action="store_true",
+                   help="use a fit result that did not converge (`converged: false`), with a "
+                        "warning; refused without it")
     add_strict(p)
     p.set_defaults(run=run)
 
@@ -52,6 +56,7 @@ def run(args: argparse.Namespace) -> int:
     from ..data.experiment import experiment
     from ..data.models import model_from_spec
     from ..executor import executor_for
+    from ..fitting.params_io import fit_notes
 
     if args.samples < 1:
         raise InputError(f"--samples must be at least 1, got {args.samples}")
@@ -61,6 +66,8 @@ def run(args: argparse.Namespace) -> int:
     for name, path in files.items():
         outputs.file(f"--out {name}", path, new_folder=True)
     outputs.check()
+    for note in fit_notes(args.fit, force=args.force):
+        print(f"warning: {note}", file=sys.stderr)
     fit = read_fit(args.fit)
     case = load_case(args.case, strict=args.strict)
     exp = experiment(case, model_from_spec(args.model or fit.model_spec, case))

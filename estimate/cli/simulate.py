@@ -31,6 +31,9 @@ def add_parser(sub: argparse._SubParsersAction) -> None:
     p.add_argument("--integrator", choices=("rk4", "adaptive"), default="rk4",
                    help="fixed-step RK4 on the sample grid (default) or CVODES")
     p.add_argument("--overwrite", action="store_true", help="replace an existing --out file")
+    p.add_argument("--force", action="store_true",
+                   help="use a fit result that did not converge (`converged: false`), with a "
+                        "warning; refused without it")
     add_strict(p)
     p.set_defaults(run=run)
 
@@ -43,11 +46,13 @@ def run(args: argparse.Namespace) -> int:
     from ..data import load_case
     from ..data.experiment import experiment
     from ..data.models import BASELINE, model_from_spec
-    from ..fitting.params_io import fitted_initial_state, read_params
+    from ..fitting.params_io import fit_notes, fitted_initial_state, read_params
 
     outputs = Outputs(overwrite=args.overwrite, inputs=[args.case, args.params])
     outputs.file("--out", args.out).check()
     case = load_case(args.case, strict=args.strict)
+    for note in fit_notes(args.params, force=args.force, what="parameter file"):
+        print(f"warning: {note}", file=sys.stderr)
     params = read_params(args.params)
     x0 = fitted_initial_state(args.params, case) if case.test.initial_state == "free" else None
     exp = experiment(case, model_from_spec(BASELINE if args.model is None else args.model, case))

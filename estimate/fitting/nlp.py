@@ -32,7 +32,11 @@ from .result import FitResult, derived_quantities
 from .terms import CaseTerms, case_terms
 from .transcription import MultipleShooting, Transcription
 
-__all__ = ["fit", "Hessian"]
+__all__ = ["LOW_R_SQUARED", "fit", "Hessian"]
+
+#: A fit whose R^2 (fraction of the measurement's variance the model explains) is below this
+#: says so in a warning: a force column of pure noise fits "converged" with R^2 near 0.
+LOW_R_SQUARED = 0.1
 
 _IPOPT_DEFAULTS = {
     # tol 1e-6 (IPOPT's 1e-8 by default): the estimates move by < 1e-5 standard errors
@@ -354,6 +358,12 @@ def _result(problem: FitProblem, theta: np.ndarray, stats: dict, recorder: Recor
     F_all = np.concatenate([t.scaled_measured[np.tile(t.weights, c) > 0]
                             for t, c in zip(terms, nch)])
     ssr = float(report @ report)
+    r_squared = 1 - ssr / float(np.sum((F_all - F_all.mean()) ** 2))
+    if not r_squared >= LOW_R_SQUARED:
+        warnings.append(f"the model explains almost nothing of the measurement (R^2 = "
+                        f"{r_squared:.3g}): the record may hold noise only, a channel of "
+                        "another quantity, or a drive that does not excite the model; check it "
+                        "before using these estimates")
     derived, derived_units = derived_quantities(problem, theta, unc.covariance,
                                                 np.array([side is None for side in at_bound]))
     pieces = np.split(raw, np.cumsum([int(np.size(m)) for m in measured])[:-1])
@@ -363,7 +373,7 @@ def _result(problem: FitProblem, theta: np.ndarray, stats: dict, recorder: Recor
         problem=problem,
         values=theta, stderr=unc.stderr, covariance=unc.covariance,
         cost=ssr, rms_residual=math.sqrt(ssr / n_force),
-        r_squared=1 - ssr / float(np.sum((F_all - F_all.mean()) ** 2)),
+        r_squared=r_squared,
         n_samples=n_force, iterations=int(stats.get("iter_count", len(recorder.costs))),
         seconds=time.perf_counter() - t_start, converged=converged, status=status,
         warnings=tuple(warnings), identifiability=unc.identifiability,

@@ -12,7 +12,7 @@ import numpy as np
 
 from analogs.errors import InputError
 
-__all__ = ["Fit", "read_fit", "read_params", "read_json", "fitted_initial_state"]
+__all__ = ["Fit", "fit_notes", "read_fit", "read_params", "read_json", "fitted_initial_state"]
 
 
 def read_json(path: str | Path, what: str) -> object:
@@ -51,6 +51,37 @@ def read_params(path: str | Path) -> dict[str, float]:
     if problems:
         raise InputError(f"{path}: " + "; ".join(problems))
     return out
+
+
+def fit_notes(path: str | Path, *, force: bool = False, what: str = "fit file") -> list[str]:
+    """Warnings about the fit result ``path`` before a command uses it; a flat map of values
+    gives none.
+
+    Raises
+    ------
+    InputError
+        When the file says the fit did not converge (``"converged": false``), unless
+        ``force`` (``--force``): then a warning says it is used anyway.
+    """
+    from .nlp import LOW_R_SQUARED
+
+    data = read_json(path, what)
+    if not isinstance(data, dict):
+        return []
+    notes = []
+    converged, status = data.get("converged"), data.get("status")
+    if converged is False:
+        what = (f"{path}: the fit did not converge (`converged: false`"
+                + (f", IPOPT status {status}" if isinstance(status, str) else "") + ")")
+        if not force:
+            raise InputError(f"{what}: its values are not estimates; fit again (other start "
+                             "values, model or options), or pass --force to use them anyway")
+        notes.append(f"{what}; its values are used because of --force")
+    r2 = data.get("r_squared")
+    if _is_number(r2) and r2 < LOW_R_SQUARED:
+        notes.append(f"{path}: the fitted model explains almost nothing of the measurement "
+                     f"(R^2 = {r2:.3g}); its values may not describe the tank")
+    return notes
 
 
 def fitted_initial_state(path: str | Path, case) -> dict[str, float]:
