@@ -15,51 +15,52 @@ Public API::
     problem = FitProblem.build(load_case("examples/A1.toml"), model)
     result = fit(problem)
     print(result.report())
+
+The names are imported when first used (PEP 562), so ``import estimate.cli`` - the ``slosh``
+command's start - does not load CasADi, SciPy and the rest before the command can answer a
+Ctrl-C with one line.
 """
 
-from .analysis.ntc import (
-                           NutationTimeConstant,
-                           envelope_growth_rate,
-                           linearize,
-                           nutation_time_constant,
-                           steady_spin,
-)
-from .data.case import Case, CaseError
-from .data.experiment import Experiment, experiment
-from .data.models import BASELINE, model_from_spec
-from .data.reader import load_case
-from .data.writer import write_case
-from .diagnosis.search import Diagnosis, Finding, diagnose
-from .fitting.measurement import ChannelOffsets
-from .fitting.nlp import Hessian, fit
-from .fitting.problem import FitProblem
-from .fitting.profile import profile_interval
-from .fitting.result import FitResult
-from .fitting.transcription import Collocation, MultipleShooting
+import importlib
 
-__all__ = [
-    "BASELINE",
-    "Case",
-    "CaseError",
-    "ChannelOffsets",
-    "Collocation",
-    "Diagnosis",
-    "Experiment",
-    "FitProblem",
-    "FitResult",
-    "Finding",
-    "Hessian",
-    "MultipleShooting",
-    "NutationTimeConstant",
-    "diagnose",
-    "envelope_growth_rate",
-    "experiment",
-    "fit",
-    "linearize",
-    "load_case",
-    "model_from_spec",
-    "nutation_time_constant",
-    "profile_interval",
-    "steady_spin",
-    "write_case",
-]
+#: Public name -> module that defines it.
+_EXPORTS = {
+    "BASELINE": ".data.models",
+    "Case": ".data.case",
+    "CaseError": ".data.case",
+    "ChannelOffsets": ".fitting.measurement",
+    "Collocation": ".fitting.transcription",
+    "Diagnosis": ".diagnosis.search",
+    "Experiment": ".data.experiment",
+    "FitProblem": ".fitting.problem",
+    "FitResult": ".fitting.result",
+    "Finding": ".diagnosis.search",
+    "Hessian": ".fitting.nlp",
+    "MultipleShooting": ".fitting.transcription",
+    "NutationTimeConstant": ".analysis.ntc",
+    "diagnose": ".diagnosis.search",
+    "envelope_growth_rate": ".analysis.ntc",
+    "experiment": ".data.experiment",
+    "fit": ".fitting.nlp",
+    "linearize": ".analysis.ntc",
+    "load_case": ".data.reader",
+    "model_from_spec": ".data.models",
+    "nutation_time_constant": ".analysis.ntc",
+    "profile_interval": ".fitting.profile",
+    "steady_spin": ".analysis.ntc",
+    "write_case": ".data.writer",
+}
+
+__all__ = sorted(_EXPORTS)
+
+
+def __getattr__(name: str):
+    if name not in _EXPORTS:
+        raise AttributeError(f"module {__name__!r} has no attribute {name!r}")
+    value = getattr(importlib.import_module(_EXPORTS[name], __name__), name)
+    globals()[name] = value
+    return value
+
+
+def __dir__() -> list[str]:
+    return sorted({*globals(), *__all__})

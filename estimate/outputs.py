@@ -39,10 +39,15 @@ from analogs.errors import InputError
 from .inputs import file_kind
 from .interrupts import deferred, temporary
 
-__all__ = ["NON_FINITE_KEY", "OutputError", "Outputs", "json_text"]
+__all__ = ["NON_FINITE_KEY", "OutputError", "Outputs", "committed", "json_text"]
 
 #: Key of the note that lists the values written as ``null`` because they were not finite.
 NON_FINITE_KEY = "non_finite"
+
+
+#: Outputs renamed into place since the command line cleared the list (it does so when a
+#: command starts): a signal after that does not undo them.
+committed: list[Path] = []
 
 
 class OutputError(InputError):
@@ -233,6 +238,7 @@ class Outputs:
                 for backup, final in backups:
                     os.replace(backup, final)
                 raise
+            committed.extend(final for _, final in moves)
         for backup, _ in backups:
             _remove(backup)
 

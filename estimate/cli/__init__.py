@@ -32,19 +32,35 @@ def main(argv: list[str] | None = None) -> int:
     models, parameter values, options, output paths), file-system errors and missing
     optional libraries are printed as one line (status 2); anything else is a defect and
     shows its traceback. SIGINT and SIGTERM abort the command (:mod:`estimate.interrupts`):
-    nothing is written, one line says so, and the status is 130 or 143.
+    nothing is written, one line says so, and the status is 130 or 143; a Ctrl-C while the
+    command is still starting (importing its libraries) is one line and 130 too. A signal
+    that arrives once the command's outputs are written (renamed into place) does not undo
+    them: one line says they are complete and the status is the command's.
     """
+    try:
+        return _main(argv)
+    except KeyboardInterrupt:  # before the command's own handlers: its libraries loading
+        print("slosh: interrupted by SIGINT while starting: nothing was written",
+              file=sys.stderr)
+        return 130
+
+
+def _main(argv: list[str] | None) -> int:
     for var in ("OMP_NUM_THREADS", "OPENBLAS_NUM_THREADS", "MKL_NUM_THREADS"):
         os.environ.setdefault(var, "1")
     args = _parser().parse_args(argv)
     from analogs.errors import InputError, MissingDependency
 
     from ..interrupts import Interrupted, handled, received
+    from ..outputs import committed
 
+    committed.clear()
     with handled(f"slosh {args.command}"), _one_line_warnings():
         try:
             status = args.run(args)
         except Interrupted as err:
+            if committed:
+                return _after_outputs(args.command, err, 0)
             return _interrupted(args.command, err, written=False)
         except (InputError, MissingDependency) as err:
             return _fail(args.command, str(err))
@@ -53,10 +69,21 @@ def main(argv: list[str] | None = None) -> int:
         except Exception:
             if received() is None:  # a defect, not an interrupt that some code wrapped
                 raise
+            if committed:
+                return _after_outputs(args.command, Interrupted(received()), 0)
             return _interrupted(args.command, Interrupted(received()), written=False)
-        if received() is not None:  # arrived while the outputs were being renamed
-            return _interrupted(args.command, Interrupted(received()), written=True)
+        if received() is not None:  # arrived while the outputs were being renamed, or after
+            return _after_outputs(args.command, Interrupted(received()), int(status or 0))
     return int(status or 0)
+
+
+def _after_outputs(command: str, err, status: int) -> int:
+    from ..outputs import committed
+
+    names = ", ".join(str(p) for p in committed) or "none"
+    print(f"slosh {command}: {err.signal_name} arrived after the command had written its "
+          f"outputs ({names}); they are complete", file=sys.stderr)
+    return status
 
 
 @contextmanager
