@@ -142,7 +142,7 @@ class DaskExecutor(Executor):
         if client is not None:
             self.client = client
         elif address is not None:
-            self.client = distributed.Client(address)
+            self.client = _connect(distributed, address)
         else:
             self._cluster = distributed.LocalCluster(
                 n_workers=n_workers or os.cpu_count() or 1, threads_per_worker=1,
@@ -182,6 +182,22 @@ class DaskExecutor(Executor):
 
     def __repr__(self) -> str:
         return f"DaskExecutor({self.client.scheduler.address!r})"
+
+
+def _connect(distributed, address: str):
+    """A client of the scheduler at ``address``; a malformed or unreachable address is an
+    :class:`InputError` naming it (``--scheduler`` on the command line)."""
+    where = f"--scheduler {address!r}"
+    if not isinstance(address, str) or "://" not in address:
+        raise InputError(f"{where}: expected a scheduler address such as tcp://127.0.0.1:8786")
+    try:
+        return distributed.Client(address)
+    except (ValueError, TypeError) as err:  # a port that is not a number, an unknown protocol
+        raise InputError(f"{where}: not a scheduler address ({err}); expected one such as "
+                         "tcp://127.0.0.1:8786") from None
+    except (OSError, TimeoutError) as err:
+        raise InputError(f"{where}: no scheduler answers ({err}); start one with `dask "
+                         "scheduler` (and workers with `dask worker ADDRESS`)") from None
 
 
 def executor_for(scheduler: str | None = None, *, local: bool = False,

@@ -54,6 +54,7 @@ import numpy as np
 from analogs.errors import MissingDependency
 
 from ..inputs import open_input
+from ._lab_damage import captured_warnings, mat5_damage
 from ._samples import check_samples, rows_text
 from .budget import decimation_hint, max_samples
 from .case import SPINNING_CHANNELS, Rig
@@ -214,13 +215,15 @@ def _unit_problem(unit: str, target: str | None) -> str | None:
     ureg = _registry()
     try:
         parsed = ureg.parse_units(unit)
-    except (pint.errors.PintError, ValueError, TypeError, AttributeError, SyntaxError) as exc:
+        compatible = target is None or ureg.Quantity(1.0, parsed).is_compatible_with(target)
+    except Exception as exc:  # noqa: BLE001 - pint's parser raises anything on odd text
+        detail = str(exc).strip()
         reason = "not a unit pint knows" if isinstance(exc, pint.errors.UndefinedUnitError) \
-            else f"not a unit expression ({exc})"
+            else "not a unit expression" + (f" ({detail})" if detail else "")
         expected = f"{_KIND[target]} unit such as {_EXAMPLE_UNITS[target]}" if target else \
             "a unit such as \"deg\" or \"V\""
         return f'unknown unit "{unit}": {reason} (expected {expected})'
-    if target is not None and not ureg.Quantity(1.0, parsed).is_compatible_with(target):
+    if not compatible:
         dims = ureg.get_dimensionality(parsed)
         return (f'unit "{unit}" ({dims}) is not {_KIND[target]} unit (expected one such as '
                 f"{_EXAMPLE_UNITS[target]})")
@@ -362,16 +365,40 @@ def read_lab(path: Path, toml_name: str, doc: Mapping[str, Any], excitation: str
                                 f"`{spec.channel}` of {name}")
     if len(problems) > n_before:
         return None
-    with contextlib.ExitStack() as stack:
+    with contextlib.ExitStack() as stack, captured_warnings("nptdms") as logged:
         try:
             channels, listing = _open(path, fmt, stack)
+            if fmt == "MAT" and (damage := _mat5_damage(path)):
+                raise ValueError(damage)
         except MissingDependency:
             raise
         except Exception as exc:  # each library raises its own errors on a damaged file
-            problems.append(f"{name}: not a readable {fmt} file ({type(exc).__name__}: {exc})")
+            problems.append(f"{name}: not a readable {fmt} file (damaged or of another format: "
+                            f"{type(exc).__name__}: {exc})")
             return None
-        return _read_channels(name, fmt, wanted, channels, listing, rig_kind, rig, problems,
-                              n_before)
+        try:
+            out = _read_channels(name, fmt, wanted, channels, listing, rig_kind, rig, problems,
+                                 n_before)
+        except Exception as exc:  # noqa: BLE001 - a library failing inside a damaged file
+            del problems[n_before:]
+            problems.append(f"{name}: not a readable {fmt} file (damaged: reading its channels "
+                            f"failed: {type(exc).__name__}: {exc})")
+            return None
+        if logged:  # npTDMS read past damage and said so: what it returned is not the record
+            del problems[n_before:]
+            problems.append(f"{name}: damaged {fmt} file ({logged[0].rstrip('.')}); it was cut "
+                            "short or overwritten: copy it again from the acquisition system")
+            return None
+        return out
+
+
+def _mat5_damage(path: Path) -> str | None:
+    """Where a MAT v5 file (not v4, not the HDF5-based v7.3) ends inside a data element."""
+    from scipy.io.matlab import matfile_version
+
+    with open_input(path, "a MAT file") as fh:
+        major, _ = matfile_version(fh)
+    return mat5_damage(path) if major == 1 else None
 
 
 def _read_channels(name: str, fmt: str, wanted: dict[str, _Spec], channels: dict[str, _Channel],
@@ -429,7 +456,13 @@ def _read_channels(name: str, fmt: str, wanted: dict[str, _Spec], channels: dict
         spec = wanted[column]
         unit = spec.unit or ch.unit
         target = _target_unit(column, rig)
-        raw = np.asarray(ch.read(), dtype=float).reshape(-1)
+        read = np.asarray(ch.read())
+        if np.iscomplexobj(read):
+            problems.append(f"{name}: channel `{ch.name}` ({key(spec)}): expected real numbers, "
+                            "found complex values (a spectrum or a demodulated signal, not a "
+                            "record of the measured quantity)")
+            continue
+        raw = read.astype(float).reshape(-1)
         if unit is not None and spec.unit is None:  # the file's own unit: checked here
             why = _unit_problem(unit, target)
             if why:
