@@ -236,7 +236,7 @@ def _explicit_groups(doc: Mapping[str, Any], fname: str, records: tuple[Record, 
             problems.append(f"{where}: expected a table with `records`, found {table!r}")
             continue
         for key in sorted(set(table) - _GROUP_KEYS):
-            problems.append(f"{where}: unknown key `{key}` (known: records, model)")
+            problems.append(f"{where}: unknown key `{key}`{_nearest(key, _GROUP_KEYS)}")
         pats = table.get("records")
         if not (isinstance(pats, list) and pats and all(isinstance(p, str) for p in pats)):
             problems.append(f"{where} records: expected a list of record ids or case-file "
@@ -246,6 +246,8 @@ def _explicit_groups(doc: Mapping[str, Any], fname: str, records: tuple[Record, 
         if not isinstance(gm, str) or not gm.strip():
             problems.append(f"{where} model: expected a model specification such as "
                             f"\"fixed,p1\", found {gm!r}")
+        elif "model" in table:
+            problems += _spec_problems(gm, f"{where} model", [r for r in records])
         members = []
         for pat in pats:
             hit = [r.id for r in records
@@ -272,14 +274,14 @@ def _settings(path: Path, records: tuple[Record, ...]) -> tuple[dict[str, Any], 
     doc = load_toml(path, "the campaign file (TOML)", limit=MAX_CASE_FILE_BYTES)
     fname, problems = path.name, []
     for key in sorted(set(doc) - {"campaign", "groups"}):
-        problems.append(f"{fname}: unknown table `[{key}]` (known: [campaign], [groups.NAME])")
+        problems.append(f"{fname}: unknown table `[{key}]`"
+                        f"{_nearest(key, {'campaign', 'groups'}, table=True)}")
     settings = doc.get("campaign", {})
     if not isinstance(settings, Mapping):
         problems.append(f"{fname}: [campaign]: expected a table")
         settings = {}
     for key in sorted(set(settings) - _CAMPAIGN_KEYS):
-        problems.append(f"{fname}: [campaign]: unknown key `{key}` (known: "
-                        f"{', '.join(sorted(_CAMPAIGN_KEYS))})")
+        problems.append(f"{fname}: [campaign]: unknown key `{key}`{_nearest(key, _CAMPAIGN_KEYS)}")
     for key in sorted(_CAMPAIGN_KEYS & set(settings)):
         if not isinstance(settings[key], str):
             problems.append(f"{fname}: [campaign] {key}: expected a string, found "
@@ -287,16 +289,53 @@ def _settings(path: Path, records: tuple[Record, ...]) -> tuple[dict[str, Any], 
     if settings.get("input", "estimated") not in INPUT_MODES:
         problems.append(f"{fname}: [campaign] input: expected one of "
                         f"{', '.join(INPUT_MODES)}, found {settings['input']!r}")
+    if isinstance(settings.get("model"), str):
+        problems += _spec_problems(settings["model"], f"{fname}: [campaign] model", records)
     groups = None
     if "groups" in doc:
         model = settings.get("model") if isinstance(settings.get("model"), str) else BASELINE
-        raw = doc["groups"] if isinstance(doc["groups"], Mapping) else {}
+        raw = doc["groups"]
+        if not isinstance(raw, Mapping) or not raw:
+            problems.append(f"{fname}: groups: expected tables `[groups.NAME]` with `records = "
+                            f"[...]`, found {raw!r}"[:300])
+            raw = {}
         groups = _explicit_groups(raw, fname, records, model, problems)
     if problems:
         count = len(problems)
         raise InputError(f"{count} problem{'s' if count > 1 else ''} in the campaign file:\n"
                          + "\n".join(f"  - {p}" for p in problems))
     return dict(settings), groups
+
+
+def _nearest(key: str, known: set[str], *, table: bool = False) -> str:
+    """`` (did you mean `records`?)`` for a key close to a known one, else the known keys."""
+    import difflib
+
+    near = difflib.get_close_matches(key, sorted(known), n=1, cutoff=0.6)
+    fmt = "[{}]" if table else "{}"
+    if near:
+        return f"; did you mean `{fmt.format(near[0])}`?"
+    return f" (known: {', '.join(fmt.format(k) for k in sorted(known))})"
+
+
+def _spec_problems(spec: str, where: str, records) -> list[str]:
+    """Why the model specification ``spec`` (from ``where``) cannot be built for the rigs of
+    ``records`` (checked at discovery, so that the key that gave it is named)."""
+    from types import SimpleNamespace
+
+    from ..data.models import model_from_spec
+
+    rigs = sorted({r.setup.rig for r in records if r.setup is not None} & {"lateral", "spinning"})
+    spin = SimpleNamespace(gravity_on=True, tank_axis="spin", motion="constant")
+    for rig in rigs or ["lateral"]:
+        stub = SimpleNamespace(test=SimpleNamespace(rig=rig, excitation="spin" if rig == "spinning"
+                                                    else "measured"),
+                               rig=SimpleNamespace(spin=spin), path=where)
+        try:
+            model_from_spec(spec, stub, option=where)
+        except InputError as err:
+            return [str(err)]
+    return []
 
 
 def discover(source: str, *, model: str | None = None) -> Campaign:
@@ -342,6 +381,10 @@ def discover(source: str, *, model: str | None = None) -> Campaign:
     if dupes:
         raise InputError("record ids must be unique in a campaign; "
                          + "; ".join(f"[test] id {k!r} in {', '.join(v)}" for k, v in dupes.items()))
+    if model is not None:
+        bad = _spec_problems(model, "--model", records)
+        if bad:
+            raise InputError(bad[0])
     settings, groups = _settings(settings_file, records)
     spec = model or settings.get("model") or BASELINE
     if groups is None:

@@ -39,7 +39,6 @@ from __future__ import annotations
 
 import argparse
 import sys
-import tomllib
 from pathlib import Path
 
 from analogs.errors import InputError
@@ -71,16 +70,47 @@ def add_parser(subparsers: argparse._SubParsersAction) -> None:
     p.set_defaults(run=run)
 
 
+#: Unit of every number of a spacecraft file (ranges: :data:`estimate.data.case.PHYSICAL_RANGES`).
+_UNITS = {"spin_rate": "rad/s", "mass": "kg", "inertia_x": "kg m^2", "inertia_y": "kg m^2",
+          "inertia_z": "kg m^2", "radius": "m", "height": "m", "length": "m",
+          "hinge_height": "m", "damping": "N m s/rad", "stiffness": "N m/rad",
+          "inertia": "kg m^2", "axial_inertia": "kg m^2", "mount_radius": "m",
+          "mount_height": "m", "duration": "s", "initial_rate": "rad/s"}
+_POSITIVE = {"mass", "inertia_x", "inertia_y", "inertia_z", "length", "inertia",
+             "axial_inertia", "duration", "initial_rate"}
+
+
 def _number(table: dict, key: str, where: str, problems: list[str], required: bool = True):
+    from ..data._toml import range_problem
+
     if key not in table:
         if required:
             problems.append(f"{where}: missing `{key}`")
         return None
     value = table[key]
-    if isinstance(value, bool) or not isinstance(value, (int, float)):
+    if isinstance(value, bool) or not isinstance(value, (int, float)) or value != value:
         problems.append(f"{where}: `{key}` must be a number, got {value!r}")
         return None
+    unit = _UNITS.get(key, "")
+    why = range_problem(float(value), unit, positive=key in _POSITIVE)
+    if why:
+        problems.append(f"{where}: `{key}`: {why}, got {value!r}")
+        return None
     return float(value)
+
+
+def _triangle(values: dict[str, float], keys: tuple[str, str, str], where: str,
+              problems: list[str]) -> None:
+    """A rigid body's principal inertias obey the triangle inequality (each at most the sum
+    of the other two: a mass distribution cannot give more)."""
+    if all(k in values for k in keys):
+        for k in keys:
+            others = [values[o] for o in keys if o != k]
+            if values[k] > sum(others) * (1 + 1e-12):
+                problems.append(f"{where}: `{k}` = {values[k]:g} kg m^2 exceeds the sum of the "
+                                f"other two principal inertias ({' + '.join(f'{o:g}' for o in others)}"
+                                "): no rigid body has such inertias (triangle inequality)")
+                return
 
 
 def load_spacecraft(path: str | Path):
@@ -99,12 +129,11 @@ def load_spacecraft(path: str | Path):
     from analogs.mounted import Mounted
     from analogs.spacecraft import FreeSpacecraft
 
+    from ..data.reader import MAX_CASE_FILE_BYTES
+    from ..inputs import load_toml
+
     path = Path(path)
-    with path.open("rb") as fh:
-        try:
-            doc = tomllib.load(fh)
-        except tomllib.TOMLDecodeError as err:
-            raise InputError(f"{path}: not valid TOML: {err}") from None
+    doc = load_toml(path, "a spacecraft file (TOML)", limit=MAX_CASE_FILE_BYTES)
     problems: list[str] = []
     for key in sorted(set(doc) - {"spacecraft", "tank", "analog", "ntc"}):
         problems.append(f"{path}: unknown table `[{key}]`; expected [spacecraft], [tank], "
@@ -118,6 +147,8 @@ def load_spacecraft(path: str | Path):
         problems.append(f"{where}: unknown key `{key}`")
     params = {f"bus.{k}": v for k in _BUS_KEYS
               if (v := _number(bus, k, where, problems)) is not None}
+    _triangle({k: params[f"bus.{k}"] for k in _BUS_KEYS if f"bus.{k}" in params},
+              ("inertia_x", "inertia_y", "inertia_z"), where, problems)
     translation = bus.get("translation", True)
     if not isinstance(translation, bool):
         problems.append(f"{where}: `translation` must be true or false, got {translation!r}")
@@ -150,9 +181,10 @@ def load_spacecraft(path: str | Path):
         if not isinstance(name, str) or not name.isidentifier():
             problems.append(f"{where}: `name` must be an identifier such as \"p1\", got {name!r}")
             continue
-        for key in sorted(set(a) & _MOUNT_KEYS):
-            problems.extend(() if key == "mount_axis" or _number(a, key, where, [], False)
-                            is not None else [f"{where}: `{key}` must be a number"])
+        bad_mount = [key for key in sorted(set(a) & _MOUNT_KEYS - {"mount_axis"})
+                     if _number(a, key, where, problems, False) is None]
+        if bad_mount:
+            continue
         mount_axis = a.get("mount_axis", "parallel")
         if mount_axis not in ("parallel", "inward"):
             problems.append(f"{where}: `mount_axis` must be \"parallel\" or \"inward\", "
@@ -164,6 +196,13 @@ def load_spacecraft(path: str | Path):
             if (mount or "mount_axis" in a) else (lambda c: c)
         values = {k: _number(a, k, where, problems, required=False)
                   for k in _ANALOG_KEYS[kind] - {"name", "type", "axis", "plane"} if k in a}
+        if None in values.values():
+            continue
+        if kind == "fixed_mass" and "axial_inertia" in values:  # transverse inertia twice
+            _triangle({"inertia_x": values.get("inertia", 0.0), "inertia_y":
+                       values.get("inertia", 0.0), "inertia_z": values["axial_inertia"]},
+                      ("inertia_x", "inertia_y", "inertia_z"), f"{where} (inertia, inertia, "
+                      "axial_inertia)", problems)
         try:
             if kind == "rotor":
                 components.append(wrap(Rotor(name, axis=a.get("axis", "z"), **values)))

@@ -71,7 +71,8 @@ def run(args: argparse.Namespace) -> int:
     if bad.size:
         raise InputError(f"the simulation is not finite from t = {sim.time[bad[0]]:.6g} s on "
                          f"({bad.size} of {sim.time.size} rows): check the parameter values in "
-                         f"{args.params}; {args.out} was not written")
+                         f"{args.params} and the rig values of {args.case}; {args.out} was not "
+                         "written")
     with outputs.writing() as paths:
         np.savetxt(paths["--out"], table, delimiter=",", header=",".join(columns), comments="",
                    fmt="%.12g")

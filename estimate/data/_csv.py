@@ -4,6 +4,7 @@ from __future__ import annotations
 
 import csv
 import io
+from collections import deque
 from collections.abc import Iterator
 from pathlib import Path
 from typing import Any
@@ -34,9 +35,9 @@ def _values_text(found: list[tuple[int, str]]) -> str:
     return shown + more
 
 
-def _count_lines(path: Path) -> int:
+def _count_lines(path: Path) -> tuple[int, bool]:
     """Lines in ``path`` ending in LF, CR LF or CR, counted in 1 MiB chunks (the number of
-    its rows unless line ends are mixed)."""
+    its rows unless line ends are mixed), and whether the file ends with a line end."""
     lf = cr = 0
     last = b"\n"
     with open_input(path, "a CSV file") as fh:
@@ -44,7 +45,27 @@ def _count_lines(path: Path) -> int:
             lf += chunk.count(b"\n")
             cr += chunk.count(b"\r")
             last = chunk[-1:]
-    return max(lf, cr) + (last not in (b"\n", b"\r"))
+    ended = last in (b"\n", b"\r")
+    return max(lf, cr) + (not ended), ended
+
+
+def _digits(text: str) -> tuple[int, int]:
+    """Significant digits of a number's mantissa and digits of its exponent (``-5.2e-05``:
+    (2, 2))."""
+    mantissa, _, exponent = text.strip().lower().partition("e")
+    digits = mantissa.lstrip("+-").replace(".", "").lstrip("0")
+    return len(digits), len(exponent.lstrip("+-"))
+
+
+def _cut_short(last: str, before: list[str]) -> bool:
+    """Whether ``last``, the final number of a file without a final line end, has fewer
+    mantissa or exponent digits than every one of the numbers ``before`` it in its column:
+    the file was cut inside it (``1.2345678`` written, ``1.23`` left)."""
+    if len(before) < 5:
+        return False
+    mine = _digits(last)
+    others = [_digits(b) for b in before]
+    return mine[0] < min(o[0] for o in others) or 0 < min(o[1] for o in others) > mine[1]
 
 
 def _python_only(text: str) -> bool:
@@ -64,13 +85,14 @@ def read_csv(path: Path, excitation: str | None, problems: list[str],
     """
     name = path.name
     try:
-        n_lines = _count_lines(path)
+        n_lines, ended = _count_lines(path)
         if n_lines - 1 > max_samples():
             problems.append(f"{name}: rows: {n_lines - 1} samples; {decimation_hint(n_lines - 1)}")
             return None
         with io.TextIOWrapper(open_input(path, "a CSV file"), newline="",
                               encoding="utf-8-sig") as fh:
-            return _read_rows(csv.reader(fh), n_lines, name, excitation, problems, rig_kind)
+            return _read_rows(csv.reader(fh), n_lines, name, excitation, problems, rig_kind,
+                              ended=ended)
     except InputError as exc:  # replaced by a pipe or a device since it was checked
         problems.append(f"{name}: {str(exc).split(': ', 1)[-1]}")
         return None
@@ -89,7 +111,7 @@ def _rows(reader) -> Iterator[tuple[int, list[str]]]:
 
 
 def _read_rows(reader, n_lines: int, name: str, excitation: str | None, problems: list[str],
-               rig_kind: str | None) -> tuple[Any, ...] | None:
+               rig_kind: str | None, *, ended: bool = True) -> tuple[Any, ...] | None:
     rows = _rows(reader)
     first = next(rows, None)
     spinning = rig_kind == "spinning"
@@ -142,6 +164,7 @@ def _read_rows(reader, n_lines: int, name: str, excitation: str | None, problems
     skip_lines: set[int] = set()  # rows already reported; not reported again as NaN
     bad_numbers: dict[str, list[tuple[int, str]]] = {c: [] for c in names}
     python_only: dict[str, list[tuple[int, str]]] = {c: [] for c in names}
+    recent: deque[tuple[int, str]] = deque(maxlen=21)  # (line, last field) of the last rows
     i = -1
     for i, (line, row) in enumerate(rows):
         if i == data.shape[0]:  # mixed line ends: more rows than counted
@@ -157,6 +180,7 @@ def _read_rows(reader, n_lines: int, name: str, excitation: str | None, problems
             bad_fields.append(f"line {line} ({len(row)} fields)")
             skip_lines.add(line)
             continue
+        recent.append((line, row[-1]))
         for j, text in enumerate(row):
             try:
                 data[i, j] = float(text)
@@ -166,6 +190,13 @@ def _read_rows(reader, n_lines: int, name: str, excitation: str | None, problems
             if _python_only(text):
                 python_only[names[j]].append((line, text))
     data, lines = data[:i + 1], lines[:i + 1]
+    if not ended and recent and i >= 0 and recent[-1][0] == lines[i] \
+            and _cut_short(recent[-1][1], [t for _, t in list(recent)[:-1]]):
+        line, text = recent[-1]
+        problems.append(f"{name}: line {line}: the file ends inside a number: `{text.strip()}` "
+                        f"(column `{names[-1]}`) has fewer digits than each of the "
+                        f"{len(recent) - 1} rows before it and no line end follows; the file "
+                        "was cut short: copy it again, or remove its last row")
     if bad_fields:
         shown = "; ".join(bad_fields[:_MAX_LISTED_ROWS])
         more = (f" and {len(bad_fields) - _MAX_LISTED_ROWS} more"

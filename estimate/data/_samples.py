@@ -9,11 +9,14 @@ from collections.abc import Callable, Collection, Mapping, Sequence
 import numpy as np
 from numpy.typing import NDArray
 
-from .case import MIN_DURATION, MIN_SAMPLES, TIME_STEP_RTOL
+from .case import MIN_DURATION, MIN_SAMPLES, PHYSICAL_RANGES, SPINNING_CHANNELS, TIME_STEP_RTOL
 
 __all__ = ["MAX_LISTED_ROWS", "check_samples", "rows_text"]
 
 MAX_LISTED_ROWS = 10
+#: Unit of each measured column whose magnitude is bounded (:data:`PHYSICAL_RANGES`).
+_UNITS = {"displacement": "m", "force": "N",
+          **{c: "N" if c.startswith("force") else "N m" for c in SPINNING_CHANNELS}}
 
 
 def rows_text(rows: Sequence[int], word: str = "line", plural: str | None = None) -> str:
@@ -26,14 +29,17 @@ def rows_text(rows: Sequence[int], word: str = "line", plural: str | None = None
 
 def check_samples(name: str, columns: Sequence[str], data: NDArray[np.float64], problems: list[str],
                   *, row: Callable[[int], int], where: Callable[[list[int]], str],
-                  skip: Mapping[str, Collection[int]] | None = None, kind: str = "column") -> None:
+                  skip: Mapping[str, Collection[int]] | None = None, kind: str = "column",
+                  quantities: Sequence[str] | None = None) -> None:
     """Append the problems of the samples ``data`` (one column per name in ``columns``, the
     first the time in s) of the file ``name``.
 
     ``row(i)`` is how a problem names sample ``i`` (a line of a CSV, an index of a channel),
     ``where(rows)`` lists several; the rows in ``skip[column]`` were reported already and
     are not reported again as non-finite. ``kind`` is what a problem calls a column
-    ("column" of a CSV, "channel" of a lab file).
+    ("column" of a CSV, "channel" of a lab file); ``quantities`` are the case's column
+    names of the columns (default ``columns``): a displacement, force or torque beyond
+    :data:`~estimate.data.case.PHYSICAL_RANGES` (a force of 1e300 N) is refused.
     """
     for j, col in enumerate(columns):
         known = (skip or {}).get(col, ())
@@ -41,6 +47,18 @@ def check_samples(name: str, columns: Sequence[str], data: NDArray[np.float64], 
         if nonfinite:
             problems.append(f"{name}: {kind} `{col}`: expected finite numbers, found "
                             f"{len(nonfinite)} NaN or inf value(s) at {where(nonfinite)}")
+    for j, (col, quantity) in enumerate(zip(columns, quantities or columns)):
+        unit = _UNITS.get(quantity)
+        if unit is None:
+            continue
+        high, what = PHYSICAL_RANGES[unit][1:]
+        with np.errstate(invalid="ignore"):
+            huge = np.flatnonzero(np.abs(data[:, j]) > high)
+        if huge.size:
+            at = [row(int(i)) for i in huge]
+            problems.append(f"{name}: {kind} `{col}`: expected a {what} of magnitude up to "
+                            f"{high:g} {unit}, found {huge.size} value(s) beyond it (the largest "
+                            f"{float(np.nanmax(np.abs(data[huge, j]))):.3g}) at {where(at)}")
     n = data.shape[0]
     if n < MIN_SAMPLES:
         problems.append(f"{name}: rows: expected at least {MIN_SAMPLES} samples, found {n}")

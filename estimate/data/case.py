@@ -169,6 +169,8 @@ PHYSICAL_RANGES: dict[str, tuple[float, float, str]] = {
     "N": (0.0, 1e9, "force"),
     "N m": (0.0, 1e9, "torque"),
     "kg m^2": (1e-12, 1e9, "moment of inertia"),
+    "N m s/rad": (0.0, 1e9, "rotational damping"),
+    "N m/rad": (0.0, 1e9, "rotational stiffness"),
 }
 """Values accepted for a number of each unit in a case or spacecraft file: (smallest
 positive value, largest magnitude, what it is). Wide enough for any tank test or spacecraft

@@ -483,7 +483,8 @@ def _read_channels(name: str, fmt: str, wanted: dict[str, _Spec], channels: dict
     order.insert(0, "time")
     data = np.column_stack([values[c] for c in order])
     check_samples(name, [labels[c] for c in order], data, problems, row=lambda i: i,
-                  where=lambda rows: rows_text(rows, "index", "indices"), kind="channel")
+                  where=lambda rows: rows_text(rows, "index", "indices"), kind="channel",
+                  quantities=order)
     if len(problems) > n_before:
         return None
     time = values["time"]

@@ -115,7 +115,7 @@ def _number_of(name: str, letter: str) -> int | None:
     return int(digits) if digits == str(int(digits)) else None
 
 
-def model_from_spec(spec: str, case: Case) -> Model:
+def model_from_spec(spec: str, case: Case, *, option: str = "--model") -> Model:
     """Build a model from a comma-separated specification such as ``"fixed,p1,p2"``.
 
     Tokens: ``fixed`` (FixedMass); ``pN`` with N from 1 to ``MAX_MODES`` (6: the modes the
@@ -124,7 +124,8 @@ def model_from_spec(spec: str, case: Case) -> Model:
     ``pN:nospring`` (no hinge spring), ``pN:quadratic`` (adds a QuadraticDamper),
     ``pN:diaphragm`` (adds a DiaphragmSpring); spinning rig only: ``rotor`` or ``rN``
     (a Rotor about the tangential tank axis :data:`ROTOR_AXIS`, coupled by a viscous damper).
-    Errors name the option (``--model``) and list the valid tokens.
+    Errors name the option (``option``: ``--model``, or the file and key the specification
+    came from) and list the valid tokens.
 
     Examples
     --------
@@ -175,6 +176,6 @@ def model_from_spec(spec: str, case: Case) -> Model:
         else:
             problems.append(f"`{tok}`: unknown component")
     if problems:
-        raise InputError(f"--model {spec!r}: " + "; ".join(problems) + "; "
+        raise InputError(f"{option} {spec!r}: " + "; ".join(problems) + "; "
                          + _tokens_text(spinning))
     return model.validate()
