@@ -300,9 +300,10 @@ def _settings(path: Path, records: tuple[Record, ...]) -> tuple[dict[str, Any], 
                             f"[...]`, found {raw!r}"[:300])
             raw = {}
         groups = _explicit_groups(raw, fname, records, model, problems)
+    if len(problems) == 1:  # one line, as every other input error
+        raise InputError(problems[0])
     if problems:
-        count = len(problems)
-        raise InputError(f"{count} problem{'s' if count > 1 else ''} in the campaign file:\n"
+        raise InputError(f"{len(problems)} problems in the campaign file:\n"
                          + "\n".join(f"  - {p}" for p in problems))
     return dict(settings), groups
 

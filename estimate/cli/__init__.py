@@ -35,14 +35,20 @@ def main(argv: list[str] | None = None) -> int:
     nothing is written, one line says so, and the status is 130 or 143; a Ctrl-C while the
     command is still starting (importing its libraries) is one line and 130 too. A signal
     that arrives once the command's outputs are written (renamed into place) does not undo
-    them: one line says they are complete and the status is the command's.
+    them: one line says they are complete and the status is the command's (and the
+    ``slosh`` program, called without ``argv``, ignores SIGINT once the command returned).
     """
     try:
-        return _main(argv)
+        status = _main(argv)
     except KeyboardInterrupt:  # before the command's own handlers: its libraries loading
         print("slosh: interrupted by SIGINT while starting: nothing was written",
               file=sys.stderr)
         return 130
+    if argv is None:  # the `slosh` program: done, a Ctrl-C while Python exits changes nothing
+        import signal
+
+        signal.signal(signal.SIGINT, signal.SIG_IGN)
+    return status
 
 
 def _main(argv: list[str] | None) -> int:

@@ -3,9 +3,10 @@
 from __future__ import annotations
 
 from collections.abc import Sequence
+from typing import TYPE_CHECKING
 
-from ..data import Case, load_case
-from ..data.records import refuse_repeated
+if TYPE_CHECKING:  # the parser of every command imports this module: load nothing yet
+    from ..data import Case
 
 __all__ = ["add_strict", "load_cases"]
 
@@ -18,7 +19,7 @@ def add_strict(parser) -> None:
 
 
 def load_cases(paths: Sequence[str], *, prediction: bool = False, strict: bool = False
-               ) -> tuple[list[Case], list[str]]:
+               ) -> tuple[list["Case"], list[str]]:
     """The cases of ``paths`` and warnings about them (``strict``: unknown keys are errors,
     :func:`estimate.data.load_case`).
 
@@ -26,6 +27,9 @@ def load_cases(paths: Sequence[str], *, prediction: bool = False, strict: bool =
     ``prediction``: a ``[prediction]`` that contradicts the tank's own modal prediction is
     a warning (:func:`estimate.fitting.initial.prediction_conflicts`).
     """
+    from ..data import load_case
+    from ..data.records import refuse_repeated
+
     cases = [load_case(p, strict=strict) for p in paths]
     refuse_repeated(cases)
     notes: list[str] = []
