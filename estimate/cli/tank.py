@@ -132,10 +132,31 @@ def _plot(args: argparse.Namespace, tank, liquid: Liquid, path: str, pred) -> No
     return fig
 
 
+#: Unit of each numeric option (ranges: :data:`estimate.data.case.PHYSICAL_RANGES`).
+_UNITS = {"radius": "m", "length": "m", "density": "kg/m^3", "viscosity": "m^2/s",
+          "gravity": "m/s^2"}
+
+
+def _check_ranges(args: argparse.Namespace) -> None:
+    """Options outside the physical ranges a case file's keys have (``--radius 1e300``)."""
+    from ..data._toml import range_problem
+
+    problems = []
+    for name, unit in _UNITS.items():
+        value = getattr(args, name, None)
+        if value is not None and value == value:  # NaN: the tank module's own check says it
+            why = range_problem(value, unit, positive=True)
+            if why:
+                problems.append(f"--{name} {value:g}: {why}")
+    if problems:
+        raise InputError("; ".join(problems))
+
+
 def run(args: argparse.Namespace) -> int:
     """Run ``slosh tank``; returns the exit status (2 on bad input)."""
     outputs = Outputs(overwrite=args.overwrite)
     outputs.file("--json", args.json).file("--plot", args.plot).check()
+    _check_ranges(args)
     try:
         tank = _tank(args)
         liquid = Liquid(density=args.density, viscosity=args.viscosity, name="liquid")

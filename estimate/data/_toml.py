@@ -118,7 +118,8 @@ def range_problem(value: float, unit: str, *, positive: bool = False) -> str | N
     low, high, what = PHYSICAL_RANGES[unit]
     if abs(value) > high or (positive and value < low):
         span = f"{low:g} to {high:g}" if positive else f"a magnitude up to {high:g}"
-        return f"expected {span} {unit} (the range accepted for a {what})"
+        article = "an" if what[0] in "aeiou" else "a"
+        return f"expected {span} {unit} (the range accepted for {article} {what})"
     return None
 
 

@@ -402,6 +402,12 @@ def _(d):
     assert "A1.csv: column `force`: expected a force of magnitude up to 1e+09 N" in line
 
 
+@row("beyond: slosh tank --radius 1e300 names the option and the range")
+def _(d):
+    line = _error(slosh(["tank", "--radius", "1e300", "--fill", "0.5"], d))
+    assert "--radius 1e+300: expected 1e-06 to 1000 m (the range accepted for a length)" in line
+
+
 @row("weak: a CSV cut inside its last number is refused")
 def _(d):
     text = (EXAMPLES / "A1.csv").read_text()[:-5]  # "...,-5.2252685571\n" -> "-5.2252685"
