@@ -13,7 +13,7 @@ from types import SimpleNamespace
 
 from analogs import Model
 from analogs.errors import InputError
-from analogs.vehicle import VehicleFrame
+from analogs.vehicle import VehicleFrame, axisymmetric, degrees_of_freedom
 
 from ..outputs import Outputs
 
@@ -40,9 +40,13 @@ def add_parser(subparsers: argparse._SubParsersAction) -> None:
     p.add_argument("--interface", choices=("rig", "vehicle"), default="rig",
                    help="rig: lateral rig inputs rig.x, rig.x_dot, rig.x_ddot (default); "
                         "vehicle: tank-frame acceleration, angular velocity and acceleration "
-                        "and gravity (analogs.vehicle.VehicleFrame)")
+                        "and gravity (analogs.vehicle.VehicleFrame); the lateral fit's "
+                        "pendulums become spherical pendulums (same mass, length, height, "
+                        "hinge spring and damper), which slosh along tank x and y as in an "
+                        "axisymmetric tank")
     p.add_argument("--planar", action="store_true",
-                   help="with --interface vehicle: in-plane (x-z) inputs only")
+                   help="with --interface vehicle: in-plane (x-z) inputs only, planar "
+                        "pendulums (no slosh along tank y)")
     p.add_argument("--set", metavar="NAME=VALUE", action="append", default=[],
                    help="set a parameter the fit does not give (e.g. p1.hinge_height=0.1, "
                         "needed by torques and by the vehicle interface); repeatable")
@@ -60,7 +64,15 @@ def export_model(spec: str, values: dict[str, float], *, interface: str = "rig",
 
     ``interface="rig"``: a lateral rig with a measured carriage displacement (inputs
     ``rig.x``, ``rig.x_dot``, ``rig.x_ddot``); ``"vehicle"``: the
-    :class:`~analogs.vehicle.VehicleFrame` (``planar`` for in-plane inputs only).
+    :class:`~analogs.vehicle.VehicleFrame` with the analog made three-dimensional for an
+    axisymmetric tank (:func:`analogs.vehicle.axisymmetric`: each planar pendulum becomes a
+    spherical pendulum, so the slosh responds along tank x and y), or with ``planar`` the
+    in-plane (x-z) inputs and the planar analog.
+
+    Raises
+    ------
+    InputError
+        For an unknown interface, or a vehicle analog that cannot be made 3-D.
     """
     from ..data.models import model_from_spec
 
@@ -68,11 +80,20 @@ def export_model(spec: str, values: dict[str, float], *, interface: str = "rig",
                               path="(export)")
     model = model_from_spec(spec, lateral)
     if interface == "vehicle":
-        model = (Model((VehicleFrame(planar=planar),)) + model.without(model.rig.name)).validate()
+        analog = model.without(model.rig.name)
+        if not planar:
+            analog = axisymmetric(analog)
+        model = (Model((VehicleFrame(planar=planar),)) + analog).validate()
     elif interface != "rig":
         raise InputError(f"interface must be 'rig' or 'vehicle', got {interface!r}")
     names = {p.name for p in model.parameters}
     return model, {k: v for k, v in values.items() if k in names}
+
+
+def _print_dof(model: Model) -> None:
+    print("  degrees of freedom:")
+    for line in degrees_of_freedom(model):
+        print(f"    {line}")
 
 
 def _spec_of(path: Path) -> str | None:
@@ -159,6 +180,7 @@ def run(args: argparse.Namespace) -> int:
         print(f"wrote C export of {spec} ({args.interface} interface) to {args.out}: "
               f"{ex.header.name}, {', '.join(s.name for s in ex.sources)}, {ex.driver.name}, "
               f"{ex.makefile.name}, {ex.parameters_csv.name}")
+        _print_dof(model)
         print(f"  states: {', '.join(ex.states)}")
         print(f"  inputs: {', '.join(ex.inputs) or '(none)'}")
         if args.no_build:
@@ -170,7 +192,9 @@ def run(args: argparse.Namespace) -> int:
         else:
             print(f"  built {Path(args.out) / 'simulate'}")
     if args.fmu:
-        print(f"wrote FMU {args.fmu}")
+        print(f"wrote FMU {args.fmu} of {spec} ({args.interface} interface)")
+        if not args.out:
+            _print_dof(model)
     if unset:
         print(f"  note: no value for {', '.join(unset)}: outputs that need them are NaN in C "
               "and left out of the FMU")
