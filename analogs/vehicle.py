@@ -12,7 +12,7 @@ from typing import TYPE_CHECKING
 from .component import Attachment, Component, Rig
 from .errors import InputError
 from .fixed_mass import FixedMass
-from .hinge import DiaphragmSpring, HingeDamper, HingeSpring
+from .hinge import DiaphragmSpring, HingeDamper, HingeSpring, SwingDamper
 from .parameter import Param
 from .pendulum import Pendulum, SphericalPendulum
 
@@ -107,7 +107,7 @@ class VehicleFrame(Rig):
 #: Hinge elements that act alike on a spherical pendulum's two angles and on a planar
 #: pendulum's one: linear in the angle or its rate, so a swing along either tank axis is the
 #: planar swing and any other direction agrees at small amplitude.
-_LINEAR_HINGE = (HingeSpring, HingeDamper, DiaphragmSpring)
+_LINEAR_HINGE = (HingeSpring, HingeDamper, DiaphragmSpring, SwingDamper)
 
 
 def axisymmetric(model: "Model") -> "Model":
@@ -118,10 +118,11 @@ def axisymmetric(model: "Model") -> "Model":
     The slosh mass, length, hinge height and hinge spring and damper are the same about
     both lateral axes, as they are in a tank symmetric about its z axis (a sphere,
     cylinder or capsule); a swing along tank x or along tank y is then exactly the planar
-    analog's swing. The hinge elements act on each of the spherical pendulum's angles
-    (``alpha`` toward +x, ``beta`` toward +y): for a swing in another direction the spring
-    and damper agree with an isotropic hinge to second order in the swing angle (the
-    damping of the ``alpha`` rate is ``c`` instead of ``c cos(beta)^2``).
+    analog's swing. The hinge damper becomes a :class:`~analogs.SwingDamper` (the same
+    ``damping``, on the rod's angular velocity), so the damping is the same in every
+    direction of swing; the hinge spring and a diaphragm act on each of the spherical
+    pendulum's angles (``alpha`` toward +x, ``beta`` toward +y), which for a swing in
+    another direction agrees with an isotropic hinge to second order in the swing angle.
 
     Raises
     ------
@@ -135,7 +136,7 @@ def axisymmetric(model: "Model") -> "Model":
     >>> from analogs import FixedMass, HingeDamper, LateralRig, Pendulum
     >>> m = axisymmetric(LateralRig() + FixedMass("fixed") + Pendulum("p1") + HingeDamper("p1"))
     >>> [type(c).__name__ for c in m.components]
-    ['LateralRig', 'FixedMass', 'SphericalPendulum', 'HingeDamper']
+    ['LateralRig', 'FixedMass', 'SphericalPendulum', 'SwingDamper']
     """
     from .model import Model
 
@@ -144,6 +145,8 @@ def axisymmetric(model: "Model") -> "Model":
     for c in model.components:
         if type(c) is Pendulum:
             out.append(SphericalPendulum(c.name, bounds=c._bounds, **c._values))
+        elif type(c) is HingeDamper and c.host in planar:
+            out.append(SwingDamper(c.host, bounds=c._bounds, **c._values))
         elif isinstance(c, (Rig, FixedMass, SphericalPendulum)):
             out.append(c)
         elif isinstance(c, Attachment) and c.host in planar:

@@ -23,15 +23,26 @@ __all__ = ["add_parser", "run", "export_model"]
 def add_parser(subparsers: argparse._SubParsersAction) -> None:
     """Add the ``export`` subcommand to an argparse subparsers object."""
     p = subparsers.add_parser(
-        "export", help="export a fitted analog as C code (and/or an FMU)",
+        "export", help="export a fitted analog as C code, an FMU or Basilisk effectors",
         description="Generate self-contained C (CasADi code generation of rhs, outputs and a "
                     "fixed-step RK4 step; header with state/input/parameter/output order and "
-                    "units; fitted values as defaults; Makefile; standalone driver) and/or an "
-                    "FMI 2.0 co-simulation FMU from a fit result.")
+                    "units; fitted values as defaults; Makefile; standalone driver), an "
+                    "FMI 2.0 co-simulation FMU and/or a Python module of Basilisk slosh "
+                    "effectors from a fit result.")
     p.add_argument("fit", metavar="FIT.json", help="fit result (as written by `slosh fit`) "
                    "or a flat JSON map of parameter values")
     p.add_argument("--out", metavar="DIR", help="folder for the C sources")
     p.add_argument("--fmu", metavar="OUT.fmu", help="write an FMI 2.0 co-simulation FMU")
+    p.add_argument("--basilisk", metavar="OUT.py",
+                   help="write the analog as Basilisk slosh effectors (sphericalPendulum, "
+                        "linearSpringMassDamper; rigid liquid added to the hub): a Python "
+                        "module with add_slosh(scObject); needs no Basilisk to write")
+    p.add_argument("--tank-position", metavar="X,Y,Z", type=_vector, default=None,
+                   help="with --basilisk: the tank origin (tank bottom, on its axis) in the "
+                        "spacecraft body frame, m (default 0,0,0)")
+    p.add_argument("--tank-axis", metavar="X,Y,Z", type=_vector, default=None,
+                   help="with --basilisk: the tank axis in the body frame, pointing from the "
+                        "tank bottom to the free surface (default 0,0,1)")
     p.add_argument("--model", default=None,
                    help="model specification, e.g. 'fixed,p1' (default: the fit's model_spec)")
     p.add_argument("--integrator", choices=("rk4", "adaptive"), default="rk4",
@@ -90,6 +101,16 @@ def export_model(spec: str, values: dict[str, float], *, interface: str = "rig",
     return model, {k: v for k, v in values.items() if k in names}
 
 
+def _vector(text: str) -> tuple[float, float, float]:
+    parts = text.split(",")
+    try:
+        if len(parts) != 3:
+            raise ValueError
+        return tuple(float(x) for x in parts)  # type: ignore[return-value]
+    except ValueError:
+        raise argparse.ArgumentTypeError(f"expected three numbers X,Y,Z, got {text!r}") from None
+
+
 def _print_dof(model: Model) -> None:
     print("  degrees of freedom:")
     for line in degrees_of_freedom(model):
@@ -137,13 +158,19 @@ def run(args: argparse.Namespace) -> int:
     from ..data.models import BASELINE
     from ..fitting.params_io import read_params
 
-    if not args.out and not args.fmu:
-        raise InputError("nothing to write: give `--out DIR` for C sources and/or `--fmu OUT.fmu`")
+    if not args.out and not args.fmu and not args.basilisk:
+        raise InputError("nothing to write: give `--out DIR` for C sources, `--fmu OUT.fmu` "
+                         "and/or `--basilisk OUT.py`")
+    if (args.tank_position or args.tank_axis) and not args.basilisk:
+        raise InputError("`--tank-position` and `--tank-axis` place the tank for `--basilisk`")
     if args.integrator != "rk4":
         raise InputError("only `--integrator rk4` can be exported: CasADi's cvodes integrator "
                          "cannot be generated as C")
     if args.planar and args.interface != "vehicle":
         raise InputError("`--planar` applies to `--interface vehicle` only")
+    if args.basilisk and not args.basilisk.endswith(".py"):
+        raise InputError(f"--basilisk {args.basilisk}: the Basilisk module's file name must end "
+                         "in .py")
     if args.fmu and not has_c_compiler():
         raise InputError(f"--fmu {args.fmu}: an FMU holds a compiled binary and no C compiler was "
                          "found (install gcc, or set CC to one); `--out DIR` writes the C "
@@ -152,11 +179,19 @@ def run(args: argparse.Namespace) -> int:
     spec = args.model or _spec_of(Path(args.fit)) or BASELINE
     outputs = Outputs(overwrite=args.overwrite, inputs=[args.fit])
     outputs.folder("--out", args.out, [*c_export_files(args.name).values(), "simulate"])
-    outputs.file("--fmu", args.fmu).check()
+    outputs.file("--fmu", args.fmu).file("--basilisk", args.basilisk).check()
     model, used = export_model(spec, values, interface=args.interface, planar=args.planar)
-    dm = derive(model)
-    pvec = dm.parameter_vector(used)
-    unset = [n for n, v in zip(dm.parameter_names, pvec) if math.isnan(v)]
+    basilisk = None
+    if args.basilisk:
+        from derive.export_basilisk import basilisk_analog
+
+        basilisk = basilisk_analog(model, values, tank_position=args.tank_position,
+                                   tank_axis=args.tank_axis, source=str(args.fit))
+    unset = []
+    if args.out or args.fmu:
+        dm = derive(model)
+        pvec = dm.parameter_vector(used)
+        unset = [n for n, v in zip(dm.parameter_names, pvec) if math.isnan(v)]
     with outputs.writing() as paths:
         if args.out:
             ex = export_c(dm, paths["--out"], used, substeps=args.substeps, name=args.name,
@@ -176,6 +211,8 @@ def run(args: argparse.Namespace) -> int:
                            name=args.name, overwrite=True)
             except RuntimeError as err:  # no compiler, or compiling failed: the compiler's words
                 raise InputError(f"--fmu {args.fmu}: {err}") from None
+        if basilisk is not None:
+            paths["--basilisk"].write_text(basilisk.script(module=Path(args.basilisk).stem))
     if args.out:
         print(f"wrote C export of {spec} ({args.interface} interface) to {args.out}: "
               f"{ex.header.name}, {', '.join(s.name for s in ex.sources)}, {ex.driver.name}, "
@@ -195,6 +232,16 @@ def run(args: argparse.Namespace) -> int:
         print(f"wrote FMU {args.fmu} of {spec} ({args.interface} interface)")
         if not args.out:
             _print_dof(model)
+    if basilisk is not None:
+        print(f"wrote Basilisk effectors of {spec} to {args.basilisk}: "
+              f"{len(basilisk.pendulums)} sphericalPendulum, {len(basilisk.spring_masses)} "
+              f"linearSpringMassDamper, {len(basilisk.rigid_masses)} rigid mass(es) for the hub; "
+              f"{basilisk.placement}")
+        print(f"  use: `import {Path(args.basilisk).stem}` then "
+              f"`{Path(args.basilisk).stem}.add_slosh(scObject)` after setting the hub's mass "
+              "properties")
+        if not args.out and not args.fmu:
+            _print_dof(axisymmetric(model.without(model.rig.name)))
     if unset:
         print(f"  note: no value for {', '.join(unset)}: outputs that need them are NaN in C "
               "and left out of the FMU")

@@ -1,121 +1,30 @@
 """The vehicle export of a lateral fit sloshes along tank x and y (an axisymmetric tank).
 
 Reference: the spherical pendulum's equations of motion in a translating tank frame,
-derived by hand below and integrated with SciPy (``solve_ivp``, DOP853, rtol 1e-10); they
-import nothing from the project. The exported model (Python simulation, compiled C driver
+derived by hand in ``tests/reference_vehicle.py`` and integrated with SciPy (``solve_ivp``,
+DOP853, rtol 1e-10). The exported model (Python simulation, compiled C driver
 and FMU) driven along tank y must give the x-drive response turned by 90 degrees.
 """
 
 from __future__ import annotations
 
-import math
-from pathlib import Path
-
 import numpy as np
 import pytest
-from scipy.integrate import solve_ivp
+from reference_vehicle import FIT, SETS, LateralDrive, spherical_pendulum
 
+from analogs import FixedMass, LateralRig, Pendulum, SwingDamper
 from analogs.errors import InputError
-from derive import RK4, Excitation, derive, simulate
+from derive import RK4, derive, simulate
 from derive.export_c import has_c_compiler, run_driver, write_input_csv
 from estimate.cli import main
 from estimate.cli.export import export_model
 
-EXAMPLES = Path(__file__).resolve().parents[2] / "examples"
-G = 9.80665
-#: The A1 fit (examples/A1_params.json) with the heights and inertia the README sets.
-FIT = {"fixed.mass": 1.5, "p1.mass": 1.3, "p1.length": 0.05529, "p1.stiffness": 0.0,
-       "p1.damping": 0.0010585309742484883}
-SETS = {"p1.hinge_height": 0.1, "fixed.height": 0.05, "fixed.inertia": 0.004,
-        "fixed.axial_inertia": 0.006}
-#: The README drive: 0.5 m/s^2 at the slosh frequency (2.12 Hz), swings of about 1 rad.
-AMPLITUDE, FREQUENCY = 0.5, 2.12
 #: RK4 at 1 ms against DOP853 at rtol 1e-10: the RK4 error over 10 s of a 2.1 Hz
 #: resonance swinging 1 rad, relative to the peak (observed 2e-9 along an axis, 8e-8
 #: diagonally); 1e-6 leaves margin.
 RK4_VS_REFERENCE = 1e-6
 #: The acceptance bound: the same peak force from a y drive as from an x drive.
 SAME_PEAK = 0.01
-
-
-def _drive(t, direction):
-    """Tank-frame acceleration (m/s^2) of a sine of AMPLITUDE at FREQUENCY along
-    ``direction`` (a unit vector in the x-y plane)."""
-    s = AMPLITUDE * np.sin(2 * np.pi * FREQUENCY * np.asarray(t, float))
-    return np.multiply.outer(np.asarray(direction, float), s)
-
-
-def reference(t, direction, *, m=FIT["p1.mass"], L=FIT["p1.length"], c=FIT["p1.damping"],
-              k=FIT["p1.stiffness"], rigid=FIT["fixed.mass"]):
-    """Spherical pendulum (bob ``m`` on a rod ``L`` hinged on the tank axis) in a tank
-    frame that translates with acceleration ``a(t)`` under gravity ``-G z``.
-
-    Bob direction n(al, be) = (sin al cos be, sin be, -cos al cos be); apparent gravity
-    g_app = g - a. Lagrangian L = m L^2 (cos^2 be al_dot^2 + be_dot^2) / 2 + m L g_app.n
-    - k (al^2 + be^2) / 2, dissipation c (al_dot^2 + be_dot^2) / 2 (the hinge elements act
-    on each angle):
-
-        m L^2 (cos^2 be al_dd - 2 sin be cos be al_d be_d) = m L g_app.n_al - c al_d - k al
-        m L^2 (be_dd + sin be cos be al_d^2)               = m L g_app.n_be - c be_d - k be
-
-    Force the mount applies to the tank assembly: -(rigid + m) g_app + m L n_dd.
-    Returns (angles (2, n), force (3, n)).
-    """
-
-    def n_derivatives(al, be):
-        sa, ca, sb, cb = math.sin(al), math.cos(al), math.sin(be), math.cos(be)
-        n_a = np.array([ca * cb, 0.0, sa * cb])
-        n_b = np.array([-sa * sb, cb, ca * sb])
-        n_aa = np.array([-sa * cb, 0.0, ca * cb])
-        n_ab = np.array([-ca * sb, 0.0, -sa * sb])
-        n_bb = np.array([-sa * cb, -sb, ca * cb])
-        return n_a, n_b, n_aa, n_ab, n_bb
-
-    def g_app(time):
-        a = _drive(time, direction).ravel()
-        return np.array([-a[0], -a[1], -G])
-
-    def accelerations(time, y):
-        al, be, ad, bd = y
-        n_a, n_b, *_ = n_derivatives(al, be)
-        g = g_app(time)
-        cb, sb = math.cos(be), math.sin(be)
-        add = (m * L * g @ n_a - c * ad - k * al + 2 * m * L**2 * sb * cb * ad * bd) \
-            / (m * L**2 * cb**2)
-        bdd = (m * L * g @ n_b - c * bd - k * be - m * L**2 * sb * cb * ad**2) / (m * L**2)
-        return add, bdd
-
-    def rhs(time, y):
-        return [y[2], y[3], *accelerations(time, y)]
-
-    sol = solve_ivp(rhs, (t[0], t[-1]), [0.0, 0.0, 0.0, 0.0], t_eval=t, method="DOP853",
-                    rtol=1e-10, atol=1e-12)
-    force = np.empty((3, t.size))
-    for i, (time, y) in enumerate(zip(t, sol.y.T)):
-        al, be, ad, bd = y
-        add, bdd = accelerations(time, y)
-        n_a, n_b, n_aa, n_ab, n_bb = n_derivatives(al, be)
-        n_dd = n_a * add + n_b * bdd + n_aa * ad**2 + 2 * n_ab * ad * bd + n_bb * bd**2
-        force[:, i] = -(rigid + m) * g_app(time) + m * L * n_dd
-    return sol.y[:2], force
-
-
-class _Inputs(Excitation):
-    """The vehicle inputs of a lateral drive along ``direction`` under gravity -G z."""
-
-    analytic = False
-
-    def __init__(self, names, direction):
-        self.names, self.direction, self.size = names, direction, len(names)
-
-    def values(self, t):
-        t = np.asarray(t, float)
-        out = np.zeros((self.size, t.size))
-        a = _drive(t, self.direction)
-        for i, axis in enumerate("xy"):
-            out[self.names.index(f"vehicle.accel_{axis}")] = a[i]
-        out[self.names.index("vehicle.gravity_z")] = -G
-        return out
 
 
 def _rel(a, b):
@@ -133,8 +42,8 @@ def vehicle():
 def test_exported_vehicle_model_matches_hand_written_spherical_pendulum(vehicle, direction):
     dm, used = vehicle
     t = np.linspace(0.0, 10.0, 10001)
-    sim = simulate(dm, used, t, _Inputs(dm.inputs, direction), integrator=RK4())
-    angles, force = reference(t, direction)
+    sim = simulate(dm, used, t, LateralDrive(dm.inputs, direction), integrator=RK4())
+    angles, force = spherical_pendulum(t, direction)
     assert np.max(np.abs(angles)) > 0.5  # the resonance swings the pendulum ~1 rad
     for i, name in enumerate(("p1.alpha", "p1.beta")):
         if np.ptp(angles[i]) > 0:
@@ -148,8 +57,8 @@ def test_exported_vehicle_model_matches_hand_written_spherical_pendulum(vehicle,
 def test_y_drive_is_the_x_drive_turned(vehicle):
     dm, used = vehicle
     t = np.linspace(0.0, 10.0, 10001)
-    x = simulate(dm, used, t, _Inputs(dm.inputs, (1.0, 0.0)), integrator=RK4())
-    y = simulate(dm, used, t, _Inputs(dm.inputs, (0.0, 1.0)), integrator=RK4())
+    x = simulate(dm, used, t, LateralDrive(dm.inputs, (1.0, 0.0)), integrator=RK4())
+    y = simulate(dm, used, t, LateralDrive(dm.inputs, (0.0, 1.0)), integrator=RK4())
     assert np.max(np.abs(x.output("force_x"))) > 9.0  # slosh, not the 1.4 N of the rigid mass
     assert _rel(y.output("force_y"), x.output("force_x")) < 1e-12
     assert _rel(y.state("p1.beta"), x.state("p1.alpha")) < 1e-12
@@ -189,12 +98,12 @@ def test_c_export_sloshes_alike_along_x_and_y(tmp_path, capsys):
     t = np.arange(0.0, 10.0, 0.001)
     peaks = {}
     for axis, direction in (("x", (1.0, 0.0)), ("y", (0.0, 1.0))):
-        write_input_csv(tmp_path / f"{axis}.csv", t, _Inputs(names, direction).values(t).T, names)
+        write_input_csv(tmp_path / f"{axis}.csv", t, LateralDrive(names, direction).values(t).T, names)
         res = run_driver(out / "simulate", tmp_path / f"{axis}.csv", tmp_path / f"o{axis}.csv")
         header = (tmp_path / f"o{axis}.csv").read_text().splitlines()[0].split(",")
         force = res[:, header.index(f"force_{axis}")]
         peaks[axis] = np.max(np.abs(force))
-        _, ref = reference(t, direction)
+        _, ref = spherical_pendulum(t, direction)
         # linear input interpolation at 1 ms against the exact sine: ~(h w)^2/8 = 2e-6
         assert _rel(force, ref["xy".index(axis)]) < 1e-4, axis
     assert peaks["x"] > 9.0
@@ -212,10 +121,16 @@ def test_fmu_sloshes_alike_along_x_and_y(tmp_path, capsys):
     t = np.arange(0.0, 10.0 + 1e-9, 0.001)
     peaks = {}
     for axis, direction in (("x", (1.0, 0.0)), ("y", (0.0, 1.0))):
-        u = _Inputs(names, direction).values(t)
+        u = LateralDrive(names, direction).values(t)
         signals = np.array(list(zip(t, *u)), dtype=[("time", float)] + [(n, float) for n in names])
         res = fmpy.simulate_fmu(str(fmu), stop_time=10.0, output_interval=0.001, input=signals,
                                 output=[f"force_{axis}"])
         peaks[axis] = np.max(np.abs(res[f"force_{axis}"]))
     assert peaks["x"] > 9.0
     assert abs(peaks["y"] - peaks["x"]) < SAME_PEAK * peaks["x"]
+
+
+def test_swing_damper_needs_a_spherical_pendulum():
+    with pytest.raises(ValueError, match=r"a swing damper needs a spherical pendulum's two angles "
+                                         r"\(alpha, beta\), its host has 1"):
+        derive(LateralRig() + FixedMass("fixed") + Pendulum("p1") + SwingDamper("p1"))
