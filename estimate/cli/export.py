@@ -1,4 +1,5 @@
-"""`slosh export`: a fitted analog as self-contained C (and/or an FMI 2.0 FMU).
+"""`slosh export`: a fitted analog as self-contained C, an FMI 2.0 FMU and/or a Python
+module of Basilisk slosh effectors.
 
 Wire-up: ``estimate.cli`` calls :func:`add_parser` on its subparsers and dispatches to
 :func:`run` (set as the ``func`` default).
