@@ -32,7 +32,8 @@ attaches one Basilisk state effector per slosh mass (SI units throughout):
 sphericalPendulum (massInit, pendulumRadius, tank point d, damping matrix D = c / L^2 I
 from the hinge damping c, pHat_01 where the mass hangs at rest) and linearSpringMassDamper
 (massInit, k, c, r_PB_B, pHat_B). The slosh masses are constant unless the effectors are
-pushed onto a FuelTank (pushFuelSloshParticle). Basilisk before the fixes of its issues
+pushed onto a FuelTank (add the tank to the spacecraft first, then add_slosh, then
+tank.pushFuelSloshParticle(effector) for each). Basilisk before the fixes of its issues
 1484 (the spherical pendulum's damping did no work) and 1486 (a FuelTank with slosh
 particles drained too much mass) gives other answers than the fitted analog.
 """

@@ -206,3 +206,41 @@ def test_rigid_liquid_is_added_to_the_hub(tmp_path):
     assert np.max(np.abs(change)) > 0.04
     assert np.max(np.abs(Wb - W)) < HISTORY * np.max(np.abs(change))
 
+
+
+def test_draining_tank_with_the_slosh_masses_loses_the_flow(example):
+    # Basilisk issue 1486 (fixed by pull request 1488): a FuelTank with slosh particles
+    # drained (1 + slosh mass fraction) times the flow. Pushed onto a tank leaking 0.5 kg/s,
+    # the exported pendulum and the tank together lose 0.5 kg/s, shared by their masses.
+    from Basilisk.simulation import fuelTank
+
+    sim = SimulationBaseClass.SimBaseClass()
+    sim.CreateNewProcess("dynamics").addTask(sim.CreateNewTask("step", macros.sec2nano(0.01)))
+    sc = spacecraft.Spacecraft()
+    sc.ModelTag = "spacecraft"
+    sc.hub.mHub = example.slosh.HUB["mass"]
+    sc.hub.IHubPntBc_B = [list(row) for row in example.slosh.HUB["inertia"]]
+    sc.hub.omega_BN_BInit = [[0.0], [0.0], [example.spin]]
+    tank = fuelTank.FuelTank()
+    volume = fuelTank.FuelTankModelConstantVolume()
+    volume.propMassInit = 100.0
+    volume.r_TcT_TInit = [[0.0], [0.0], [0.0]]
+    volume.radiusTankInit = 0.5
+    tank.setTankModel(volume)
+    tank.setFuelLeakRate(0.5)
+    sc.addStateEffector(tank)  # Basilisk: the tank before the particles attached to it
+    effectors = example.slosh.add_slosh(sc)
+    for e in effectors.values():
+        tank.pushFuelSloshParticle(e)
+    sim.AddModelToTask("step", sc)
+    sim.AddModelToTask("step", tank)
+    mass = sc.scMassOutMsg.recorder(macros.sec2nano(1.0))
+    sim.AddModelToTask("step", mass)
+    sim.InitializeSimulation()
+    sim.ConfigureStopTime(macros.sec2nano(10.0))
+    sim.ExecuteSimulation()
+    pendulum = example.slosh.PENDULUMS[0]
+    assert mass.massSC[0] == pytest.approx(example.slosh.HUB["mass"] + 100.0 + pendulum["mass"])
+    assert mass.massSC[0] - mass.massSC[-1] == pytest.approx(0.5 * 10.0, rel=1e-9)
+    left = sc.dynManager.getStateObject(f"slosh_{pendulum['name']}_mass").getState()[0][0]
+    assert left == pytest.approx(pendulum["mass"] * (1 - 5.0 / 120.0), rel=1e-9)
