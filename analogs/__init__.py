@@ -11,7 +11,7 @@ model into equations of motion. Models compose with ``+``::
 from .component import Attachment, Component, Rig
 from .errors import InputError, UnknownNameError
 from .fixed_mass import FixedMass
-from .hinge import DiaphragmSpring, HingeDamper, HingeSpring, QuadraticDamper
+from .hinge import DiaphragmSpring, HingeDamper, HingeSpring, QuadraticDamper, SwingDamper
 from .hinge_nonlinear import CubicHingeSpring, HingeFriction, HingeTorqueTerms
 from .model import Model, ModelError
 from .mounted import Mounted
@@ -51,6 +51,7 @@ __all__ = [
     "SphericalPendulum",
     "SpinningRig",
     "SuspendedMass",
+    "SwingDamper",
     "ThreeDofPendulum",
     "UnknownNameError",
     "VehicleFrame",

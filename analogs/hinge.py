@@ -10,7 +10,7 @@ from .parameter import Param
 if TYPE_CHECKING:  # pragma: no cover
     from .declaration import Declaration
 
-__all__ = ["HingeSpring", "HingeDamper", "QuadraticDamper", "DiaphragmSpring"]
+__all__ = ["HingeSpring", "HingeDamper", "SwingDamper", "QuadraticDamper", "DiaphragmSpring"]
 
 
 class HingeSpring(Attachment):
@@ -49,6 +49,27 @@ class HingeDamper(Attachment):
 
     def declare(self, k: "Declaration") -> None:
         k.add_dissipation(sum(k.p.damping * r**2 / 2 for r in k.hinge_rates))
+
+
+class SwingDamper(HingeDamper):
+    """Linear viscous damper on a :class:`~analogs.SphericalPendulum`'s swing: torque
+    ``-c * omega`` (c in N m s/rad) with ``omega`` the rod's angular velocity relative to
+    the tank, whatever the direction of the swing.
+
+    Rayleigh dissipation ``c (cos(beta)^2 alpha_dot^2 + beta_dot^2) / 2``: the rod's
+    squared angular rate. :class:`HingeDamper` damps each angle's rate instead,
+    ``c (alpha_dot^2 + beta_dot^2) / 2``; the two agree for a swing along tank x or y and
+    to second order in the swing angle otherwise. Parameter ``<host>.damping``.
+    """
+
+    def declare(self, k: "Declaration") -> None:
+        import sympy as sp
+
+        if len(k.hinge) != 2:
+            raise ValueError(f"{self.label}: a swing damper needs a spherical pendulum's two "
+                             f"angles (alpha, beta), its host has {len(k.hinge)}")
+        (_, beta), (alpha_dot, beta_dot) = k.hinge, k.hinge_rates
+        k.add_dissipation(k.p.damping * (sp.cos(beta) ** 2 * alpha_dot**2 + beta_dot**2) / 2)
 
 
 class QuadraticDamper(Attachment):

@@ -12,6 +12,8 @@ HEADER = Template("""\
 /* $name.h - slosh analog model exported by slosh-analogs (derive.export_c).
  *
  * Model: $model
+ * Degrees of freedom:
+$dof_table
  * States x = [q; qd], inputs u, parameters p, outputs y; SI units.
  * Integrator: classical RK4, $substeps substep(s) per call of ${name}_step.
  * No runtime dependency on CasADi or Python; C99 with <math.h>.

@@ -24,6 +24,7 @@ import numpy as np
 
 from analogs.errors import InputError
 from analogs.model import Model
+from analogs.vehicle import degrees_of_freedom
 
 from ._c_templates import DRIVER, HEADER, MAKEFILE, WRAPPER
 from ._compile import c_compiler
@@ -246,6 +247,7 @@ def export_c(
         substeps=substeps, nstages=2 * substeps + 1,
         model=description or " + ".join(f"{type(c).__name__}({c.name!r})"
                                         for c in dm.model.components),
+        dof_table="\n".join(f" *   {line}" for line in degrees_of_freedom(dm.model)) or " *   (none)",
         state_table=_table([(f"x[{i}]", s, u) for i, (s, u) in enumerate(zip(dm.states, sunits))]),
         input_table=_table([(f"u[{i}]", s, u) for i, (s, u) in enumerate(zip(dm.inputs, dm.input_units))]),
         param_table=_table([(f"p[{i}]", pm.name, pm.unit, _c_double(v), pm.description)

@@ -8,6 +8,7 @@ montecarlo with an embedded Dask cluster 30 s, ntc 25-60 s cold; the others 2-12
 
 import os
 import re
+import shlex
 import shutil
 import subprocess
 import sys
@@ -20,8 +21,15 @@ ROOT = Path(__file__).resolve().parents[1]
 README = (ROOT / "README.md").read_text()
 SECTION = README[README.index("## Command line\n"):]
 SECTION = SECTION[:SECTION.index("\n## ", 1)]
-BLOCKS = [[line for line in textwrap.dedent(block).splitlines() if line.strip()]
-          for block in re.findall(r"^ *```bash\n(.*?)^ *```", SECTION, flags=re.S | re.M)]
+#: The ```bash blocks, one command a line; a ```python block right after a bash block runs
+#: (as `python3 -c`) after that block's commands, in the same folder.
+BLOCKS: list[list[str]] = []
+for _kind, _code in re.findall(r"^ *```(bash|python)\n(.*?)^ *```", SECTION, flags=re.S | re.M):
+    _code = textwrap.dedent(_code)
+    if _kind == "bash":
+        BLOCKS.append([line for line in _code.splitlines() if line.strip()])
+    else:
+        BLOCKS[-1].append(f"python3 -c {shlex.quote(_code)}")
 #: Commands that take over ~30 s (see the module docstring).
 SLOW = ("slosh diagnose", "slosh montecarlo", "slosh ntc")
 QUICK_START = re.search(r"```bash\npython3 -m pip install \. && (slosh [^\n]*)\n```", README)

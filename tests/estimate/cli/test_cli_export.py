@@ -37,3 +37,14 @@ def test_fmu_without_a_compiler_is_one_line_with_status_2(no_compiler, tmp_path,
     assert err.startswith(f"slosh export: error: --fmu {fmu}: an FMU holds a compiled binary "
                           "and no C compiler was found"), err
     assert not fmu.exists()
+
+
+def test_vehicle_export_of_an_analog_with_no_3d_form_is_one_line(tmp_path, capsys):
+    out = tmp_path / "vehicle_c"
+    assert main(["export", str(EXAMPLES / "A1_params.json"), "--model", "fixed,p1:quadratic",
+                 "--interface", "vehicle", "--out", str(out), "--no-build"]) == 2
+    err = capsys.readouterr().err
+    assert err.count("\n") == 1 and "Traceback" not in err, err
+    assert "cannot be made three-dimensional (slosh along tank x and y): QuadraticDamper on " \
+           "'p1'" in err and "`--planar`" in err, err
+    assert not out.exists()
