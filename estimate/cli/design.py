@@ -81,8 +81,8 @@ def run(args: argparse.Namespace) -> int:
     families = tuple(f.strip() for f in args.families.split(",") if f.strip()) \
         if args.families else None
     if args.discriminate:
-        result = discrimination(args.discriminate, case, duration=duration, max_swing=max_swing,
-                                families=families)
+        result = discrimination(args.discriminate, case, fit=args.fit, duration=duration,
+                                max_swing=max_swing, families=families)
     else:
         targets = [t.strip() for t in args.target.split(",") if t.strip()] if args.target else None
         problem = DesignProblem.build(args.fit, case, targets=targets, criterion=args.criterion,

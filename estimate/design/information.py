@@ -155,17 +155,13 @@ def motion_inputs(motion: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
     return stages.reshape(3 * motion.shape[0], n), np.ascontiguousarray(motion[:, ::2])
 
 
-_KEPT: dict = {}
-
-
 def sensitivities(dm: DerivedModel, names: Sequence[str], channels: Sequence[str],
                   n: int) -> Sensitivities:
     """The :class:`Sensitivities` of ``dm`` for ``names``, ``channels`` and ``n`` intervals,
-    built once per process."""
-    key = (id(dm), tuple(names), tuple(channels), n)
-    if key not in _KEPT:
-        _KEPT[key] = Sensitivities(dm, tuple(names), tuple(channels), n)
-    return _KEPT[key]
+    built once per derived structure (kept with its functions,
+    :meth:`derive.DerivedModel.memoized`)."""
+    key = ("design_sensitivities", tuple(names), tuple(channels), n)
+    return dm.memoized(key, lambda: Sensitivities(dm, tuple(names), tuple(channels), n))
 
 
 def swing_angles(dm: DerivedModel, states: np.ndarray) -> dict[str, np.ndarray]:

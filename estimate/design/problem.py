@@ -45,16 +45,16 @@ def required_limits(case: Case) -> Limits:
     limits = case.rig.limits
     missing = [k for k in keys if limits is None or getattr(limits, k) is None]
     if missing:
-        example = {"stroke": "0.1   # m, total carriage travel",
-                   "velocity": "0.5   # m/s", "acceleration": "5.0   # m/s^2",
-                   "duration": "60.0   # s, longest record",
-                   "spin_rate": "10.0   # rad/s", "nutation_frequency": "1.0   # Hz",
-                   "cone_angle": "0.1   # rad"}
+        example = {"stroke": "0.1` (m, total carriage travel)", "velocity": "0.5` (m/s)",
+                   "acceleration": "5.0` (m/s^2)", "duration": "60.0` (s, longest record)",
+                   "spin_rate": "10.0` (rad/s)", "nutation_frequency": "1.0` (Hz)",
+                   "cone_angle": "0.1` (rad, cone half-angle)"}
         what = "has no `[rig.limits]` table" if limits is None else \
             "`[rig.limits]` lacks " + ", ".join(f"`{k}`" for k in missing)
         raise InputError(f"{case.path}: {what}; a design keeps every drive within what the "
-                         f"{case.test.rig} rig can run: add\n[rig.limits]\n"
-                         + "\n".join(f"{k} = {example[k]}" for k in missing))
+                         f"{case.test.rig} rig can run: give "
+                         + ", ".join(f"`{k} = {example[k]}" for k in missing)
+                         + " in `[rig.limits]`")
     return limits
 
 

@@ -15,7 +15,7 @@ from .information import Prediction
 from .problem import LINEAR_SWING, DesignProblem
 from .search import Candidate, Search, spin_case
 
-__all__ = ["Design", "gain_text"]
+__all__ = ["Design", "drive_table", "gain_text", "write_drive"]
 
 #: A correlation above which a target that misses the goal is named confounded with another.
 STILL_CONFOUNDED = 0.99
@@ -172,24 +172,12 @@ class Design:
         return "\n".join(lines)
 
     def drive_table(self) -> tuple[list[str], np.ndarray]:
-        """The recommended drive as the rig takes it, at the rig's rate: ``time,displacement``
-        (s, m) on the lateral rig; ``time,spin_angle,spin_rate,nutation_phase,cone_angle``
-        (s, rad, rad/s, rad, rad) on the spinning rig."""
-        p = self.problem
-        t = p.time
-        d = self.recommended.drive
-        if isinstance(d, SpinDrive):
-            from ..data.spin import spin_excitation
-
-            u = np.asarray(spin_excitation(spin_case(p, d)).values(t))
-            return (["time", "spin_angle", "spin_rate", "nutation_phase", "cone_angle"],
-                    np.column_stack([t, u[0], u[1], u[3], u[6]]))
-        return ["time", "displacement"], np.column_stack([t, d.motion(t)[0]])
+        """The recommended drive as the rig takes it (:func:`drive_table`)."""
+        return drive_table(self.problem, self.recommended.drive)
 
     def write_drive(self, path: Path) -> None:
-        header, rows = self.drive_table()
-        np.savetxt(path, rows, delimiter=",", header=",".join(header), comments="",
-                   fmt="%.10g")
+        """Write :meth:`drive_table` as CSV (:func:`write_drive`)."""
+        write_drive(path, *self.drive_table())
 
     def plot(self, path: Path) -> None:
         from .._plotting import figure, save
@@ -248,3 +236,22 @@ class Design:
         ax.set_ylabel("predicted 95 % half-width [%]")
         ax.legend(fontsize=8)
         save(fig, path)
+
+
+def drive_table(problem: DesignProblem, drive) -> tuple[list[str], np.ndarray]:
+    """A drive as the rig takes it, at the rig's rate: ``time,displacement`` (s, m) on the
+    lateral rig; ``time,spin_angle,spin_rate,nutation_phase,cone_angle`` (s, rad, rad/s,
+    rad, rad) on the spinning rig."""
+    t = problem.time
+    if isinstance(drive, SpinDrive):
+        from ..data.spin import spin_excitation
+
+        u = np.asarray(spin_excitation(spin_case(problem, drive)).values(t))
+        return (["time", "spin_angle", "spin_rate", "nutation_phase", "cone_angle"],
+                np.column_stack([t, u[0], u[1], u[3], u[6]]))
+    return ["time", "displacement"], np.column_stack([t, drive.motion(t)[0]])
+
+
+def write_drive(path: Path, header: list[str], rows: np.ndarray) -> None:
+    """A drive table as CSV with a header line, ten significant digits."""
+    np.savetxt(path, rows, delimiter=",", header=",".join(header), comments="", fmt="%.10g")

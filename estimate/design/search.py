@@ -18,7 +18,15 @@ from scipy.optimize import brentq, minimize, minimize_scalar
 
 from analogs.errors import InputError
 
-from .drives import LATERAL_FAMILIES, LateralDrive, LinearChirp, Peaks, SpinDrive, SteadySine
+from .drives import (
+    LATERAL_FAMILIES,
+    LIMIT_MARGIN,
+    LateralDrive,
+    LinearChirp,
+    Peaks,
+    SpinDrive,
+    SteadySine,
+)
 from .information import (
     Prediction,
     Record,
@@ -30,16 +38,13 @@ from .information import (
 )
 from .problem import DesignProblem, with_spin
 
-__all__ = ["Candidate", "Search", "evaluate", "judge", "search", "standard_alternatives",
-           "spin_case", "LIMIT_MARGIN"]
+__all__ = ["Candidate", "Runner", "Search", "band", "evaluate", "family_search", "judge", "search",
+           "spin_bounds", "spin_case", "standard_alternatives", "LIMIT_MARGIN"]
 
 #: Grid points of a 1-D family (2-D families: about 1.5 times as many pairs).
 GRID = 14
 #: Function evaluations of a local solve.
 LOCAL_EVALUATIONS = 12
-#: Relative margin kept from each limit: peaks are read at twice the rig's rate, which
-#: misses at most ``1 - cos(pi f / (2 rate))`` of a peak (0.5 % at a tenth of the rate).
-LIMIT_MARGIN = 0.01
 
 
 @dataclass(frozen=True)
@@ -73,14 +78,19 @@ def spin_case(problem: DesignProblem, drive: SpinDrive):
                      nutation_phase=None, cone_angle=None)
 
 
-class _Runner:
-    """Simulations of one drive at any amplitude scale. A lateral drive's motion is linear
-    in its scale, so it is evaluated once, on the half-interval grid (the RK4 stage times,
-    twice the rig's rate for the peaks); a spinning-rig drive's schedule is rebuilt."""
+class Runner:
+    """Simulations of one drive at any amplitude scale, for the problem's model or another
+    (``derived`` with its parameter ``values`` and estimated ``names``). A lateral drive's
+    motion is linear in its scale, so it is evaluated once, on the half-interval grid (the
+    RK4 stage times, twice the rig's rate for the peaks); a spinning-rig drive's schedule is
+    rebuilt."""
 
-    def __init__(self, problem: DesignProblem, drive) -> None:
+    def __init__(self, problem: DesignProblem, drive, *, derived=None, values=None,
+                 names=None) -> None:
         self.problem, self.drive = problem, drive
-        self.dm, self.values = problem.derived, problem.values
+        self.dm = problem.derived if derived is None else derived
+        self.values = problem.values if values is None else values
+        self.names = problem.names if names is None else tuple(names)
         if isinstance(drive, LateralDrive):
             t = problem.time
             self.unit = replace(drive, scale=1.0).motion(np.linspace(t[0], t[-1], 2 * t.size - 1))
@@ -104,7 +114,7 @@ class _Runner:
 
     def _sens(self):
         n = self.problem.time.size - 1
-        return sensitivities(self.dm, self.problem.names, self.problem.channels, n)
+        return sensitivities(self.dm, self.names, self.problem.channels, n)
 
     def swing(self, scale: float) -> float:
         u = self.inputs(scale)
@@ -125,7 +135,7 @@ def evaluate(problem: DesignProblem, drive, *, label: str = "",
     """``drive`` scaled to the limits (or to ``scale``, if smaller) and then to the swing
     limit, scored by the surrogate information; ``None`` when even a thousandth of that
     amplitude swings beyond the limit."""
-    run = _Runner(problem, drive)
+    run = Runner(problem, drive)
     if isinstance(drive, SpinDrive):
         top, limited = 1.0 if scale is None else min(scale, 1.0), "cone_angle"
     else:
@@ -185,7 +195,15 @@ def judge(problem: DesignProblem, cand: Candidate) -> Candidate:
     return replace(cand, prediction=pred)
 
 
-def _band(problem: DesignProblem) -> tuple[float, float]:
+def spin_bounds(problem: DesignProblem) -> list[tuple[float, float]]:
+    """Bounds of the spinning-rig search: spin rate from a fifth of the limit to the limit
+    (rad/s), coning frequency within +/- its limit (Hz)."""
+    lim = problem.limits
+    return [(0.2 * lim.spin_rate, lim.spin_rate),
+            (-lim.nutation_frequency, lim.nutation_frequency)]
+
+
+def band(problem: DesignProblem) -> tuple[float, float]:
     """Frequency band of the lateral search (Hz): from a fifth of the lowest mode to three
     times the highest (0.2-5 Hz without a mode), below a tenth of the rig's rate."""
     f = list(problem.frequencies.values())
@@ -206,17 +224,21 @@ class Search:
     seconds: float
 
 
-def _family_search(problem: DesignProblem, family, bounds, counter) -> Candidate | None:
-    """A grid over the design variables, then a local solve from its best point: SciPy's
-    bounded Brent between the neighbours of the best point (1-D) or Powell within the
-    bounds (2-D). Returns the best candidate seen."""
+def family_search(problem: DesignProblem, family, bounds, counter: list[int],
+                  score=evaluate):
+    """A grid over the design variables of ``family`` within ``bounds``, then a local solve
+    from its best point: SciPy's bounded Brent between the neighbours of the best point
+    (1-D) or Powell within the bounds (2-D). ``score(problem, drive, label=...)`` returns a
+    candidate with a ``score`` (smaller is better) or ``None``; ``counter[0]`` counts the
+    drives scored. Returns the best candidate seen, or ``None``."""
     nvar = len(family.variables)
     found: dict[tuple, Candidate] = {}
 
     def objective(v) -> float:
         counter[0] += 1
         v = tuple(float(x) for x in np.atleast_1d(v))
-        c = evaluate(problem, family(problem.limits, problem.duration, *v), label=family.title)
+        drive = family(problem.limits, problem.duration, **dict(zip(family.variables, v)))
+        c = score(problem, drive, label=family.title)
         if c is None:
             return math.inf
         found[v] = c
@@ -255,10 +277,7 @@ def search(problem: DesignProblem, *, families: tuple[str, ...] | None = None,
     counter = [0]
     best: list[Candidate] = []
     if problem.case.test.rig == "spinning":
-        lim = problem.limits
-        bounds = [(0.2 * lim.spin_rate, lim.spin_rate),
-                  (-lim.nutation_frequency, lim.nutation_frequency)]
-        c = _family_search(problem, SpinDrive, bounds, counter)
+        c = family_search(problem, SpinDrive, spin_bounds(problem), counter)
         best += [c] if c is not None else []
     else:
         names = tuple(families or LATERAL_FAMILIES)
@@ -266,10 +285,10 @@ def search(problem: DesignProblem, *, families: tuple[str, ...] | None = None,
         if unknown:
             raise InputError(f"--families: unknown {', '.join(map(repr, unknown))}; known: "
                              + ", ".join(LATERAL_FAMILIES))
-        lo, hi = _band(problem)
+        lo, hi = band(problem)
         for name in names:
             fam = LATERAL_FAMILIES[name]
-            c = _family_search(problem, fam, [(lo, hi)] * len(fam.variables), counter)
+            c = family_search(problem, fam, [(lo, hi)] * len(fam.variables), counter)
             best += [c] if c is not None else []
     if not best:
         raise InputError("no drive keeps every pendulum's swing below the swing limit "
