@@ -11,7 +11,10 @@ displacement noise 2e-5 m, fitted with ``fixed,p1``; the rig's limits are 100 mm
   standard alternatives judged by the fit's linearisation), wall and CPU, median of 3
   after a first run that compiles the sensitivity functions (kept on disk),
 * the wall time of ``slosh design`` in a new process (imports included, warm cache),
-* the number of drives simulated and the ratio of the wall time to the 30 s budget.
+* the number of drives simulated and the ratio of the wall time to the 30 s budget,
+* the same for the spinning rig (``tests/estimate/design/test_design_spinning.py``'s first
+  record: 6 rad/s, coning at -0.2 Hz, six channels, nine parameters; limits 8 rad/s, 1 Hz,
+  0.08 rad, 30 s), one timed run after a first one.
 """
 
 import json
@@ -41,6 +44,25 @@ from estimate.design import DesignProblem, design  # noqa: E402
 BUDGET = 30.0
 
 
+def _spinning(folder: Path) -> DesignProblem:
+    import reference_spinning as rs
+    from design_helpers import with_limits
+    from synthetic_cases import make_spinning_case
+
+    from estimate.data.case import Limits
+
+    rig = rs.Rig(spin_rate=6.0, radius=0.4, height=0.1, nutation_angle=0.03,
+                 nutation_frequency=-0.2, dry_mass=2.0, spin_up=12.0, nutation_ramp=5.0)
+    case, _ = make_spinning_case(folder, "S", rig,
+                                 pendulum=rs.SphericalPendulum(1.25, 0.062, 0.035, damping=5e-4),
+                                 fixed_mass=1.5, fixed_height=0.05, seed=11, tank_radius=0.1016,
+                                 duration=30.0, noise=0.015)
+    case = with_limits(case.path, Limits(spin_rate=8.0, nutation_frequency=1.0, cone_angle=0.08,
+                                         duration=30.0))
+    fit_path, _ = fit_json(folder, "S_fit", [case])
+    return DesignProblem.build(fit_path, case, targets=["fixed.mass", "p1.mass"])
+
+
 def main() -> None:
     folder = Path(tempfile.mkdtemp(prefix="bench_design_"))
     try:
@@ -58,6 +80,11 @@ def main() -> None:
 
         wall, cpu = median_times(once, repeat=3, warmup=1)
         last = runs[-1]
+        spin_problem = _spinning(folder)
+        spins = []
+        swall, scpu = median_times(lambda: spins.append(design(spin_problem)), repeat=1,
+                                   warmup=1)
+        spin = spins[-1]
         t0 = time.perf_counter()
         slosh = shutil.which("slosh")
         cmd = ([slosh] if slosh else [sys.executable, "-c", "import sys; from estimate.cli "
@@ -73,7 +100,10 @@ def main() -> None:
               f"{last.search.evaluations} | {wall / BUDGET:.2f} |")
         print(f"| `slosh design` (new process) | {cli:.1f} | - | {d['evaluations']} | "
               f"{cli / BUDGET:.2f} |")
-        print("recommended:", d["recommended"]["description"], "; ", "; ".join(d["gain"]))
+        print(f"| in-process, spinning rig, 30 s record | {swall:.1f} | {scpu:.1f} | "
+              f"{spin.search.evaluations} | {swall / BUDGET:.2f} |")
+        print("lateral:", d["recommended"]["description"], "; ", "; ".join(d["gain"]))
+        print("spinning:", spin.recommended.drive.describe(), "; ", "; ".join(spin.gains()))
     finally:
         shutil.rmtree(folder, ignore_errors=True)
 
