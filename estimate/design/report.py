@@ -227,12 +227,15 @@ class Design:
             for c in (*self.search.ranked, *self.search.alternatives)]
         width = 0.8 / len(p.targets)
         x = np.arange(len(rows_))
+        heights = np.array([[100 * pr.relative_halfwidth(n) for _, pr in rows_]
+                            for n in p.targets])
         for k, name in enumerate(p.targets):
-            ax.bar(x + k * width, [100 * pr.relative_halfwidth(name) for _, pr in rows_],
-                   width, label=name)
+            ax.bar(x + k * width, heights[k], width, label=name)
         ax.set_xticks(x + width * (len(p.targets) - 1) / 2)
         ax.set_xticklabels([textwrap.fill(r, 16) for r, _ in rows_], fontsize=7)
-        ax.set_yscale("log")
+        finite = heights[np.isfinite(heights) & (heights > 0)]
+        if finite.size and finite.max() > 10 * finite.min():
+            ax.set_yscale("log")
         ax.set_ylabel("predicted 95 % half-width [%]")
         ax.legend(fontsize=8)
         save(fig, path)
