@@ -127,6 +127,10 @@ class DesignProblem:
             raise InputError(f"goal must be a positive fraction, got {goal!r}")
         if not (0 < max_swing < math.pi / 2):
             raise InputError(f"max swing must be in (0, pi/2) rad, got {max_swing!r}")
+        if case.test.rig == "lateral" and case.test.excitation != "measured":
+            raise InputError(f"{case.path}: `[test] excitation = \"{case.test.excitation}\"`: the "
+                             "design plans carriage motions for a servo-driven rig (excitation "
+                             "= \"measured\"); a crank rig runs one near-sine per crank setting")
         limits = required_limits(case)
         if duration is None:
             duration = limits.duration

@@ -8,6 +8,7 @@ tests need no fit; the design itself is short (a 10 s record, sines only).
 from __future__ import annotations
 
 import json
+import re
 import shutil
 from pathlib import Path
 
@@ -17,6 +18,9 @@ import pytest
 from estimate.cli import main
 
 EXAMPLES = Path(__file__).resolve().parents[3] / "examples"
+#: The bundled case file without its `[rig.limits]` table (the tests give their own).
+WITHOUT_LIMITS = re.sub(r"\[rig\.limits\]\n(?:[^\[\n][^\n]*\n)*\n?", "",
+                        (EXAMPLES / "A1.toml").read_text())
 LIMITS = "[rig.limits]\nstroke = 0.1\nvelocity = 0.3\nacceleration = 2.0\nduration = 30.0\n"
 VALUES = {"fixed.mass": 1.5, "p1.mass": 1.3, "p1.length": 0.05529, "p1.damping": 1.06e-3}
 
@@ -48,7 +52,7 @@ def folder(tmp_path):
 
 def _with_limits(folder: Path, table: str = LIMITS) -> Path:
     path = folder / "A1.toml"
-    path.write_text((EXAMPLES / "A1.toml").read_text() + "\n" + table)
+    path.write_text(WITHOUT_LIMITS + "\n" + table)
     return path
 
 
@@ -94,7 +98,6 @@ def test_design_writes_json_drive_and_plot(folder, capsys):
     (LIMITS, ["--families", "square"], r"--families: unknown 'square'"),
 ])
 def test_errors_are_one_line(folder, capsys, table, extra, message):
-    import re
 
     case = _with_limits(folder, table)
     status = main(["design", str(folder / "fit.json"), str(case), "--json",
@@ -103,6 +106,17 @@ def test_errors_are_one_line(folder, capsys, table, extra, message):
     assert status == 2, err
     assert err.count("\n") == 1 and re.search(message, err), err
     assert not (folder / "d.json").exists()
+
+
+def test_a_crank_rig_is_refused(folder, capsys):
+    for name in ("A1_crank.toml", "A1_crank.csv"):
+        shutil.copy(EXAMPLES / name, folder / name)
+    case = folder / "A1_crank.toml"
+    case.write_text(case.read_text() + "\n" + LIMITS)
+    status = main(["design", str(folder / "fit.json"), str(case), "--json",
+                   str(folder / "d.json")])
+    assert status == 2
+    assert "a crank rig runs one near-sine per crank setting" in capsys.readouterr().err
 
 
 def test_discrimination_needs_two_models(folder, capsys):
