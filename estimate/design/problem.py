@@ -156,7 +156,8 @@ class DesignProblem:
         noise, rms, sx, notes = _noise(raw, fit_path, case, channels, model, values)
         freqs = {k.split(".")[0]: float(v) for k, v in (raw.get("derived") or {}).items()
                  if k.endswith(".frequency_hz") and isinstance(v, (int, float))}
-        rate = limits.sample_rate or case.sample_rate
+        # the record's rate from its median step, to 9 digits (100.00000000000213 is 100 Hz)
+        rate = limits.sample_rate or float(f"{case.sample_rate:.9g}")
         return cls(case, model, dm, limits, names, values, prior, scales, targets, criterion,
                    channels, noise, rms, sx, float(duration), float(rate), float(max_swing),
                    freqs, float(goal), Path(fit_path), tuple(notes))
