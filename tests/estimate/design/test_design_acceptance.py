@@ -30,9 +30,12 @@ from design_helpers import (
     lateral_record,
     swing_scaled,
     truth_pendulum,
+    with_limits,
 )
+from synthetic_cases import make_case, rig_record
 
 from estimate.cli import main
+from estimate.data.case import Limits, Prediction
 
 pytestmark = pytest.mark.slow
 
@@ -149,3 +152,35 @@ def test_diaphragm_length_and_spring_are_separated(tmp_path):
     assert lo <= k <= hi
     print("\nlength: predicted", design["recommended"]["predicted"]["p1.length"],
           "achieved", halfwidth(res, "p1.length"))
+
+
+def test_full_size_tank_as_predicted(tmp_path):
+    """The same question on a full-size tank (the 8-inch sphere scaled 4x: masses 64x, f1
+    1.06 Hz) on a bigger rig (400 mm, 0.4 m/s, 1 m/s^2, 60 s records): nothing in the
+    design is tuned to one tank."""
+    scale = 4.0
+    limits = Limits(stroke=0.4, velocity=0.4, acceleration=1.0, duration=60.0)
+    first, _, truth = rig_record(tmp_path, "A", lambda f1: ref.Sine(0.01, 0.4 * f1),
+                                 scale=scale, seed=7)
+    first = with_limits(first.path, limits)
+    fit_path, res_a = fit_json(tmp_path, "A_fit", [first])
+    out = tmp_path / "design.json"
+    assert main(["design", str(fit_path), str(first.path), "--target", ",".join(TARGETS),
+                 "--json", str(out)]) == 0
+    design = json.loads(out.read_text())
+    _limits_respected(design["drive_file"], limits, 100.0)
+    second, _ = make_case(tmp_path, "B", FromCSV(design["drive_file"]),
+                          pendulums=[truth["pendulum"]], fixed_mass=truth["fixed.mass"],
+                          dry_mass=1.2 * scale**3, noise=0.013, displacement_noise=2e-5,
+                          seed=8, tone=ref.Tone(0.05 * scale**3, 25.0), duration=60.0,
+                          prediction=Prediction(1.338 * scale**3, 0.057 * scale,
+                                                1.456 * scale**3, 0.007))
+    _, res = fit_json(tmp_path, "AB_fit", [first, second])
+    for n in TARGETS:
+        before = halfwidth(res_a, n)
+        predicted = design["recommended"]["predicted"][n]["halfwidth_95_relative"]
+        achieved = halfwidth(res, n)
+        print(f"\n{n}: before {before:.4g}, predicted {predicted:.4g}, achieved {achieved:.4g}")
+        assert before / achieved >= WITHIN * before / predicted
+        lo, hi = res.interval(n)
+        assert lo <= truth[n] <= hi
