@@ -308,7 +308,7 @@ class Discrimination:
         p, rec = self.problem, self.recommended
         runs = [Runner(p, rec.drive, derived=r.derived, values=r.values, names=r.names)
                 for r in self.rivals]
-        recs = [run.record(1.0) for run in runs]
+        recs = [run.record(rec.drive.scale) for run in runs]
         fig = figure(path, figsize=(9, 6))
         ax1, ax2 = fig.subplots(2, 1, sharex=True)
         t = p.time
