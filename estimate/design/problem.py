@@ -19,8 +19,8 @@ from ..data.models import model_for_case, model_from_spec, rig_values
 from ..fitting.params_io import read_fit, read_json
 from .information import prior_information
 
-__all__ = ["DesignProblem", "CRITERIA", "GOAL", "LINEAR_SWING", "MAX_SWING", "required_limits",
-           "with_spin"]
+__all__ = ["DesignProblem", "CRITERIA", "GOAL", "LINEAR_SWING", "MAX_DESIGN_RATE", "MAX_SWING",
+           "required_limits", "with_spin"]
 
 #: Optimality criteria on the targets' covariance: D (volume) and A (sum of variances).
 CRITERIA = ("D", "A")
@@ -29,6 +29,10 @@ LINEAR_SWING = 0.2
 #: Default largest predicted swing (rad) of a recommended drive: pendulum analogs of real
 #: tanks reach 0.2-0.4 rad near resonance; beyond, the liquid surface breaks.
 MAX_SWING = 0.35
+#: Highest rate of the predicted records [Hz]: a faster rig's record is predicted on a grid
+#: decimated to it, each sample standing for the k it replaces (noise / sqrt(k)). Slosh
+#: dynamics live below ~10 Hz; the information of white-noise samples adds up.
+MAX_DESIGN_RATE = 200.0
 #: Default goal: a 95 % interval within +/-5 % of the value.
 GOAL = 0.05
 #: Correlation above which two estimates count as confounded (the default targets).
@@ -163,20 +167,42 @@ class DesignProblem:
                    freqs, float(goal), Path(fit_path), tuple(notes))
 
     @property
+    def decimation(self) -> int:
+        """Rig samples per sample of the predicted record (1 up to :data:`MAX_DESIGN_RATE`)."""
+        return max(1, math.ceil(self.rate / MAX_DESIGN_RATE - 1e-9))
+
+    @property
     def time(self) -> np.ndarray:
-        """Sample times of the next record (s), at the rig's rate."""
+        """Sample times of the predicted record (s): the rig's rate, decimated to at most
+        :data:`MAX_DESIGN_RATE`."""
+        rate = self.rate / self.decimation
+        n = int(math.floor(self.duration * rate + 1e-9))
+        return np.arange(n + 1) / rate
+
+    @property
+    def rig_time(self) -> np.ndarray:
+        """Sample times of the drive file (s), at the rig's rate."""
         n = int(math.floor(self.duration * self.rate + 1e-9))
         return np.arange(n + 1) / self.rate
+
+    @property
+    def record_displacement_noise(self) -> float | None:
+        """Displacement noise of a sample of the predicted record (m)."""
+        if self.displacement_noise is None:
+            return None
+        return self.displacement_noise / math.sqrt(self.decimation)
 
     @property
     def theta(self) -> np.ndarray:
         return np.array([self.values[n] for n in self.names])
 
     def new_noise(self, rms: np.ndarray) -> np.ndarray:
-        """White noise per channel of a new record whose outputs have RMS ``rms``: the
-        fitted record's level, growing in proportion with the RMS above that record's (a
-        transducer's noise has a floor, and rig vibration grows with the drive)."""
-        return self.noise * np.maximum(1.0, np.asarray(rms) / self.rms)
+        """White noise per channel of a sample of the predicted record whose outputs have RMS
+        ``rms``: the fitted record's level, growing in proportion with the RMS above that
+        record's (a transducer's noise has a floor, and rig vibration grows with the
+        drive), over the square root of :attr:`decimation`."""
+        return (self.noise * np.maximum(1.0, np.asarray(rms) / self.rms)
+                / math.sqrt(self.decimation))
 
 
 def _targets(targets, names, fit, fit_path) -> tuple[str, ...]:

@@ -139,6 +139,7 @@ class Design:
             "limits": {k: v for k, v in vars(lim).items() if v is not None},
             "duration_s": p.duration,
             "sample_rate_hz": p.rate,
+            "predicted_record_rate_hz": p.rate / p.decimation,
             "max_swing_rad": p.max_swing,
             "goal_halfwidth_95_relative": p.goal,
             "pinned_down": {n: self.recommended.prediction.relative_halfwidth(n) <= p.goal
@@ -190,7 +191,7 @@ class Design:
         ax = axes[0]
         ratios = self._candidate_dict(rec)["limit_ratios"]
         if isinstance(rec.drive, LateralDrive):
-            ax.plot(t, 1e3 * rows[:, 1], lw=0.8, color="tab:blue")
+            ax.plot(rows[:, 0], 1e3 * rows[:, 1], lw=0.8, color="tab:blue")
             ax.set_ylabel("carriage displacement [mm]", color="tab:blue")
             twin = ax.twinx()
             twin.plot(t, rec.drive.motion(t)[2], lw=0.5, color="tab:gray", alpha=0.7)
@@ -198,8 +199,8 @@ class Design:
             twin.axhline(-p.limits.acceleration, color="tab:gray", ls=":", lw=0.8)
             twin.set_ylabel("acceleration [m/s^2] (limit dotted)", color="tab:gray")
         else:
-            ax.plot(t, rows[:, 2], lw=0.8, label="spin rate [rad/s]")
-            ax.plot(t, 100 * rows[:, 4], lw=0.8, label="cone angle [rad x 100]")
+            ax.plot(rows[:, 0], rows[:, 2], lw=0.8, label="spin rate [rad/s]")
+            ax.plot(rows[:, 0], 100 * rows[:, 4], lw=0.8, label="cone angle [rad x 100]")
             ax.set_ylabel("rig motion")
             ax.legend(loc="upper right", fontsize=8)
         ax.set_title(f"recommended: {rec.drive.describe()}\npeak / limit: " + ", ".join(
@@ -245,7 +246,7 @@ def drive_table(problem: DesignProblem, drive) -> tuple[list[str], np.ndarray]:
     """A drive as the rig takes it, at the rig's rate: ``time,displacement`` (s, m) on the
     lateral rig; ``time,spin_angle,spin_rate,nutation_phase,cone_angle`` (s, rad, rad/s,
     rad, rad) on the spinning rig."""
-    t = problem.time
+    t = problem.rig_time
     if isinstance(drive, SpinDrive):
         from ..data.spin import spin_excitation
 

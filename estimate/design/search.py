@@ -189,7 +189,7 @@ def judge(problem: DesignProblem, cand: Candidate) -> Candidate:
     known = {p.name for p in model.parameters}
     values = {k: v for k, v in problem.values.items() if k in known}
     F = fit_information(case, model, values, problem.names, cand.record, x, cand.noise,
-                        problem.displacement_noise)
+                        problem.record_displacement_noise)
     pred = Prediction.of(problem.names, problem.theta, problem.prior, F, problem.targets,
                          problem.scales)
     return replace(cand, prediction=pred)

@@ -60,8 +60,8 @@ def test_limit_amplitude():
 
 
 def _crossings(x, t):
-    s = np.signbit(x)
-    idx = np.nonzero(s[1:] != s[:-1])[0]
+    """Times where ``x`` changes sign strictly (linear interpolation between samples)."""
+    idx = np.nonzero(x[1:] * x[:-1] < 0)[0]
     return t[idx] - x[idx] * (t[idx + 1] - t[idx]) / (x[idx + 1] - x[idx])
 
 
