@@ -132,10 +132,6 @@ class LateralDrive:
         """The design variables by name."""
         return {v: float(getattr(self, v)) for v in self.variables}
 
-    def with_values(self, values) -> "LateralDrive":
-        """This drive with other design variables (a sequence in :attr:`variables` order)."""
-        return replace(self, **dict(zip(self.variables, map(float, values))), scale=1.0)
-
     @property
     def ramp(self) -> float:
         return min(RAMP, self.duration / 6)
@@ -177,11 +173,6 @@ class LateralDrive:
         n = int(round(self.duration * rate * OVERSAMPLE))
         m = np.abs(self.motion(np.linspace(0.0, self.duration, n + 1))).max(axis=1)
         return Peaks(*map(float, m))
-
-    @property
-    def frequencies(self) -> tuple[float, ...]:
-        """The frequencies the drive holds or sweeps between (Hz)."""
-        return tuple(self.values.values())
 
     def describe(self) -> str:
         raise NotImplementedError
@@ -305,10 +296,8 @@ class SpinDrive:
 
     @property
     def values(self) -> dict[str, float]:
+        """The design variables by name (rad/s, Hz)."""
         return {v: float(getattr(self, v)) for v in self.variables}
-
-    def with_values(self, values) -> "SpinDrive":
-        return replace(self, **dict(zip(self.variables, map(float, values))), scale=1.0)
 
     @property
     def cone_angle(self) -> float:
