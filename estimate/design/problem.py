@@ -94,6 +94,8 @@ class DesignProblem:
     max_swing: float
     frequencies: Mapping[str, float]
     goal: float = 0.05
+    #: SI unit of each estimated parameter (from the fit).
+    units: Mapping[str, str] = field(default_factory=dict)
     fit_path: Path | None = None
     notes: tuple[str, ...] = ()
 
@@ -164,7 +166,8 @@ class DesignProblem:
         rate = limits.sample_rate or float(f"{case.sample_rate:.9g}")
         return cls(case, model, dm, limits, names, values, prior, scales, targets, criterion,
                    channels, noise, rms, sx, float(duration), float(rate), float(max_swing),
-                   freqs, float(goal), Path(fit_path), tuple(notes))
+                   freqs, float(goal), {n: fit.units.get(n, "") for n in names},
+                   Path(fit_path), tuple(notes))
 
     @property
     def decimation(self) -> int:

@@ -11,11 +11,11 @@ from typing import Any
 import numpy as np
 
 from .drives import LateralDrive, SpinDrive
-from .information import Prediction
+from .information import Z95, Prediction
 from .problem import LINEAR_SWING, DesignProblem
 from .search import Candidate, Search, spin_case
 
-__all__ = ["Design", "drive_table", "gain_text", "write_drive"]
+__all__ = ["Design", "drive_table", "gain_text", "halfwidth_text", "write_drive"]
 
 #: A correlation above which a target that misses the goal is named confounded with another.
 STILL_CONFOUNDED = 0.99
@@ -27,10 +27,20 @@ def _percent(x: float) -> str:
     return f"+/-{100 * x:.2g} %" if x < 0.1 else f"+/-{100 * x:.0f} %"
 
 
-def gain_text(name: str, before: Prediction, after: Prediction) -> str:
-    """``"interval of p1.mass from +/-4 % to +/-0.6 %"`` (95 % half-widths over the value)."""
-    return (f"interval of {name} from {_percent(before.relative_halfwidth(name))} to "
-            f"{_percent(after.relative_halfwidth(name))}")
+def halfwidth_text(name: str, p: Prediction, unit: str = "") -> str:
+    """The 95 % half-width of ``name``: relative (``+/-0.6 %``), or in its unit when the
+    interval holds zero (a value the data cannot tell from zero has no relative width)."""
+    rel = p.relative_halfwidth(name)
+    if rel < 1:
+        return _percent(rel)
+    return f"+/-{Z95 * p.stderr(name):.2g}{' ' + unit if unit else ''}"
+
+
+def gain_text(name: str, before: Prediction, after: Prediction, unit: str = "") -> str:
+    """``"interval of p1.mass from +/-4 % to +/-0.6 %"`` (95 % half-widths over the value, or
+    in ``unit`` when an interval holds zero)."""
+    return (f"interval of {name} from {halfwidth_text(name, before, unit)} to "
+            f"{halfwidth_text(name, after, unit)}")
 
 
 def _correlation(p: Prediction, a: str, b: str) -> float:
@@ -53,7 +63,8 @@ class Design:
     # -- findings ----------------------------------------------------------------------------
     def gains(self) -> list[str]:
         after = self.recommended.prediction
-        return [gain_text(n, self.search.before, after) for n in self.problem.targets]
+        return [gain_text(n, self.search.before, after, self.problem.units.get(n, ""))
+                for n in self.problem.targets]
 
     def unseparated(self) -> list[str]:
         """Sentences for targets the recommended record leaves wider than the goal, and why."""
@@ -69,10 +80,13 @@ class Design:
             with_ = (f" from {', '.join(f'`{n}`' for n in partners)} (predicted correlation "
                      + ", ".join(f"{_correlation(after, t, n):+.4f}" for n in partners) + ")"
                      ) if partners else ""
+            unit = self.problem.units.get(t, "")
+            zero = (f" (its value {self.problem.values[t]:.3g}{' ' + unit if unit else ''} "
+                    "is not told from zero)") if width >= 1 else ""
             out.append(
                 f"`{t}` cannot be pinned down to {_percent(goal)}{with_} on this rig: the best "
                 f"drive within its limits and a swing of {self.problem.max_swing:g} rad leaves "
-                f"its interval at {_percent(width)}. "
+                f"its interval at {halfwidth_text(t, after, unit)}{zero}. "
                 + ("Within that swing the force depends on them almost only through their "
                    "combination (the pendulum's frequency); what tells them apart grows with "
                    "the swing's nonlinearity (a larger `--max-swing`, if the liquid allows "
@@ -169,7 +183,8 @@ class Design:
         lines += [f"  {g}" for g in self.gains()]
         for c in self.search.ranked[1:] + self.search.alternatives:
             lines.append(f"  instead: {c.label}: {c.drive.describe()}: " + ", ".join(
-                f"{n} {_percent(c.prediction.relative_halfwidth(n))}" for n in p.targets))
+                f"{n} {halfwidth_text(n, c.prediction, p.units.get(n, ''))}"
+                for n in p.targets))
         return "\n".join(lines)
 
     def drive_table(self) -> tuple[list[str], np.ndarray]:
