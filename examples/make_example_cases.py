@@ -44,12 +44,14 @@ from reference_models import Crank, Pendulum, hinge_damping, simulate_lateral
 
 from estimate.data import write_case
 from estimate.data.case import Crank as CaseCrank
-from estimate.data.case import Liquid, Prediction, Rig, Tank, TestInfo
+from estimate.data.case import Limits, Liquid, Prediction, Rig, Tank, TestInfo
 
 GRAVITY = 9.80665
 DRY_MASS = 1.2
 TANK = Tank(shape="sphere", radius=0.1016, fill_fraction=0.6, diaphragm=False)  # 8-inch sphere
 WATER = Liquid(density=998.2, kinematic_viscosity=1.004e-6)
+#: What the servo-driven carriage can run (``slosh design`` keeps its drives within it).
+LIMITS = Limits(stroke=0.1, velocity=0.3, acceleration=2.0, duration=30.0)
 # The seed's Table 8 SLOSH-code prediction for water at 60% fill (first mode).
 PREDICTION = Prediction(pendulum_mass=1.338, pendulum_length=0.057, fixed_mass=1.456,
                         damping_ratio=0.00703)
@@ -143,7 +145,8 @@ def main(argv: list[str] | None = None) -> int:
         rig = Rig(dry_mass=DRY_MASS, gravity=GRAVITY,
                   crank=None if measured else CaseCrank(radius=crank.radius,
                                                         rod_length=crank.rod_length,
-                                                        frequency=crank.frequency))
+                                                        frequency=crank.frequency),
+                  limits=LIMITS if measured else None)
         write_case(out / f"{name}.toml",
                    test=TestInfo(id=name, rig="lateral", data=f"{name}.csv",
                                  excitation=spec["excitation"], note=note),

@@ -1,5 +1,5 @@
 """The ``slosh`` command line, one module per command: ``fit``, ``simulate``, ``diagnose``,
-``tank``, ``export``, ``montecarlo``, ``ntc``."""
+``tank``, ``export``, ``montecarlo``, ``ntc``, ``campaign``, ``design``."""
 
 from __future__ import annotations
 
@@ -11,7 +11,8 @@ from contextlib import contextmanager
 
 __all__ = ["main"]
 
-_COMMANDS = ("fit", "simulate", "diagnose", "tank", "export", "montecarlo", "ntc", "campaign")
+_COMMANDS = ("fit", "simulate", "diagnose", "tank", "export", "montecarlo", "ntc", "campaign",
+             "design")
 
 
 def _parser() -> argparse.ArgumentParser:

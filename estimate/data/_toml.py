@@ -4,6 +4,7 @@ from __future__ import annotations
 
 import math
 from collections.abc import Mapping
+from dataclasses import replace
 from typing import Any
 
 from .case import (
@@ -335,5 +336,26 @@ def read_tables(ck: Checker, doc: Mapping[str, Any]):
     tank = _read_tank(ck, doc)
     liquid = _read_liquid(ck, doc)
     rig = _read_rig(ck, doc, excitation, rig_kind)
+    limits = _read_limits(ck, doc)
+    if rig is not None and limits is not None:
+        rig = replace(rig, limits=limits)
     pred_present, prediction = _read_prediction(ck, doc)
     return test, tank, liquid, rig, pred_present, prediction
+
+
+def _read_limits(ck: Checker, doc: Mapping[str, Any]) -> "Limits | None":  # noqa: F821
+    """The optional ``[rig.limits]`` table: every key present a positive number in its unit
+    (:data:`~estimate.data.case.LIMIT_UNITS`); other keys are ignored like elsewhere."""
+    from .case import LIMIT_UNITS, Limits
+
+    rig = doc.get("rig")
+    if not isinstance(rig, Mapping) or "limits" not in rig:
+        return None
+    t = ck.table(doc, "rig.limits", required=True)
+    if t is None:
+        return None
+    values = {key: ck.number(t, "rig.limits", key, unit=unit, positive=True)
+              for key, unit in LIMIT_UNITS.items() if key in t}
+    if any(v is None for v in values.values()):
+        return None
+    return Limits(**values)

@@ -87,6 +87,22 @@ record starts once the liquid has settled) or ``"free"`` (estimated with the par
 writes a case (TOML + CSV), e.g. for generated data, and refuses to overwrite existing files
 unless asked to.
 
+What the rig can run
+--------------------
+``slosh design`` (:mod:`estimate.design`) recommends the next test among drives the rig can
+run; an optional ``[rig.limits]`` table says what that is (the keys a design on this rig
+needs are required there, every key present must be a positive number)::
+
+    [rig.limits]
+    stroke = 0.1                 # m, total carriage travel (it stays within +/- stroke/2)
+    velocity = 0.5               # m/s, largest carriage speed
+    acceleration = 5.0           # m/s^2, largest carriage acceleration
+    duration = 60.0              # s, longest record
+    sample_rate = 100.0          # Hz, optional: rate of the drive file (default: the record's)
+    spin_rate = 10.0             # rad/s, spinning rig: largest table spin rate
+    nutation_frequency = 1.0     # Hz, spinning rig: largest coning frequency (either sign)
+    cone_angle = 0.1             # rad, spinning rig: largest cone half-angle
+
 Validation limits
 -----------------
 * Time must increase strictly and be uniform: every step must be within
@@ -117,6 +133,7 @@ __all__ = [
     "KNOWN_INITIAL_STATES",
     "KNOWN_RIGS",
     "KNOWN_SHAPES",
+    "LIMIT_UNITS",
     "MIN_DURATION",
     "MIN_SAMPLES",
     "PHYSICAL_RANGES",
@@ -124,6 +141,7 @@ __all__ = [
     "Case",
     "CaseError",
     "Crank",
+    "Limits",
     "Liquid",
     "Prediction",
     "Rig",
@@ -371,6 +389,42 @@ class Spin:
         return self.spin_up if self.nutation_start is None else self.nutation_start
 
 
+#: Keys of ``[rig.limits]`` with their units, in the order they are written.
+LIMIT_UNITS: dict[str, str] = {"stroke": "m", "velocity": "m/s", "acceleration": "m/s^2",
+                               "duration": "s", "sample_rate": "Hz", "spin_rate": "rad/s",
+                               "nutation_frequency": "Hz", "cone_angle": "rad"}
+
+
+@dataclass(frozen=True)
+class Limits:
+    """The optional ``[rig.limits]`` table: what the rig can run (see "What the rig can run"
+    in the module docstring). Every value is positive; ``None`` when absent.
+
+    Attributes
+    ----------
+    stroke : float or None
+        Total carriage travel [m]; the carriage stays within +/- ``stroke / 2`` of its centre.
+    velocity, acceleration : float or None
+        Largest carriage speed [m/s] and acceleration [m/s^2].
+    duration : float or None
+        Longest record [s].
+    sample_rate : float or None
+        Rate of the rig's drive file [Hz].
+    spin_rate, nutation_frequency, cone_angle : float or None
+        Spinning rig: largest spin rate [rad/s], coning frequency [Hz] and cone half-angle
+        [rad].
+    """
+
+    stroke: float | None = None
+    velocity: float | None = None
+    acceleration: float | None = None
+    duration: float | None = None
+    sample_rate: float | None = None
+    spin_rate: float | None = None
+    nutation_frequency: float | None = None
+    cone_angle: float | None = None
+
+
 @dataclass(frozen=True)
 class Rig:
     """The ``[rig]`` table.
@@ -385,12 +439,15 @@ class Rig:
         The ``[rig.crank]`` table when present.
     spin : Spin or None
         The ``[rig.spin]`` table (spinning rig only).
+    limits : Limits or None
+        The ``[rig.limits]`` table when present.
     """
 
     dry_mass: float
     gravity: float
     crank: Crank | None = None
     spin: Spin | None = None
+    limits: Limits | None = None
 
 
 @dataclass(frozen=True)

@@ -15,7 +15,7 @@ from typing import Any
 import numpy as np
 from numpy.typing import ArrayLike, NDArray
 
-from .case import SPINNING_CHANNELS, Case, Liquid, Prediction, Rig, Tank, TestInfo
+from .case import LIMIT_UNITS, SPINNING_CHANNELS, Case, Liquid, Prediction, Rig, Tank, TestInfo
 from .reader import load_case
 
 __all__ = ["write_case"]
@@ -83,6 +83,9 @@ def _toml_text(test: TestInfo, tank: Tank, liquid: Liquid, rig: Rig,
         table("rig.crank", [("radius", rig.crank.radius, "m"),
                             ("rod_length", rig.crank.rod_length, "m"),
                             ("frequency", rig.crank.frequency, "Hz, nominal drive")])
+    if rig.limits is not None:
+        table("rig.limits", [(k, getattr(rig.limits, k), unit) for k, unit in LIMIT_UNITS.items()
+                             if getattr(rig.limits, k) is not None])
     if prediction is not None:
         table("prediction", [("pendulum_mass", prediction.pendulum_mass, "kg"),
                              ("pendulum_length", prediction.pendulum_length, "m"),
