@@ -203,6 +203,17 @@ class Tank:
         return float(brentq(lambda h: self.volume(h) - target, 0.0, self.height,
                             xtol=1e-15 * self.height, rtol=1e-15))
 
+    def liquid_mass(self, fill: float, density: float) -> float:
+        """Mass in kg of liquid of ``density`` (kg/m^3) filled to the depth fraction
+        ``fill`` (depth / tank height).
+
+        Examples
+        --------
+        >>> round(Sphere(0.1).liquid_mass(0.5, 1000.0), 6)   # half of a 0.1 m sphere
+        2.094395
+        """
+        return float(density * self.volume(self.depth_from_fill(fill)))
+
     def centroid_height(self, depth: float) -> float:
         """Height in m of the liquid's centre of mass for liquid depth ``depth`` (m)."""
         r, z, w = self.section_rule(depth, 4, 24)

@@ -50,13 +50,15 @@ def _python_only(text: str) -> bool:
 
 
 def read_csv(path: Path, excitation: str | None, problems: list[str],
-              rig_kind: str | None = "lateral") -> tuple[Any, ...] | None:
+              rig_kind: str | None = "lateral", *, uniform: bool = True
+              ) -> tuple[Any, ...] | None:
     """Read and check the CSV; append problems; return (time, displacement, force, columns)
     or None (``columns``: the non-time columns of a spinning-rig CSV, else empty).
 
     The file is streamed: a record with more samples than the memory budget allows
     (:mod:`estimate.data.budget`) is refused before its arrays are allocated. A UTF-8 byte
-    order mark (Excel's "CSV UTF-8") is accepted.
+    order mark (Excel's "CSV UTF-8") is accepted. ``uniform=False`` accepts a time column
+    that is not uniform (``[test] resample_hz``).
     """
     name = path.name
     try:
@@ -65,7 +67,8 @@ def read_csv(path: Path, excitation: str | None, problems: list[str],
             problems.append(f"{name}: rows: {n_lines - 1} samples; {decimation_hint(n_lines - 1)}")
             return None
         with path.open("r", newline="", encoding="utf-8-sig") as fh:
-            return _read_rows(csv.reader(fh), n_lines, name, excitation, problems, rig_kind)
+            return _read_rows(csv.reader(fh), n_lines, name, excitation, problems, rig_kind,
+                              uniform)
     except OSError as exc:
         problems.append(f"{name}: cannot read the CSV file ({exc.strerror or exc})")
         return None
@@ -81,7 +84,7 @@ def _rows(reader) -> Iterator[tuple[int, list[str]]]:
 
 
 def _read_rows(reader, n_lines: int, name: str, excitation: str | None, problems: list[str],
-               rig_kind: str | None) -> tuple[Any, ...] | None:
+               rig_kind: str | None, uniform: bool = True) -> tuple[Any, ...] | None:
     rows = _rows(reader)
     first = next(rows, None)
     spinning = rig_kind == "spinning"
@@ -176,7 +179,7 @@ def _read_rows(reader, n_lines: int, name: str, excitation: str | None, problems
                             f"digits, which only Python reads: {_values_text(odd)}")
     skip = {col: skip_lines | {ln for ln, _ in bad_numbers[col]} for col in names}
     check_samples(name, names, data, problems, row=lambda i: int(lines[i]), where=_rows_text,
-                  skip=skip)
+                  skip=skip, uniform=uniform)
     t = data[:, 0]
     if len(problems) > 0:
         return None

@@ -106,7 +106,9 @@ def fit(problem: FitProblem, *, transcription: Transcription = MultipleShooting(
         available and the Hessian is Gauss-Newton (multiple shooting only).
     robust_start : bool, default True
         Initialise crank speed corrections from the force spectrum and flywheel angles
-        from a grid over their bounds (:func:`estimate.fitting.initial.crank_start`).
+        from a grid over their bounds (:func:`estimate.fitting.initial.crank_start`), and
+        start a free initial state from the state read off the record's first periods
+        (:mod:`estimate.fitting.free_state`).
     warm_start : FitResult, optional
         A previous fit of the same cases (e.g. of a smaller model): its states start the
         transcription where the coordinates agree and its estimated carriage motion starts
@@ -142,7 +144,13 @@ def fit(problem: FitProblem, *, transcription: Transcription = MultipleShooting(
     scales = np.array([e.scale for e in est])
     # the exact Hessian differentiates g twice: keep g an AD-able expression then
     blocks_ok = hessian.kind == "gauss-newton"
-    nlp, terms = _setup(problem, transcription, cost, kinds, blocks_ok, compile_, warm_start)
+    free = None
+    if robust_start and "free" in kinds:
+        from .free_state import free_starts
+
+        free = free_starts(problem, kinds)
+    nlp, terms = _setup(problem, transcription, cost, kinds, blocks_ok, compile_, warm_start,
+                        free)
     opts = dict(_IPOPT_DEFAULTS)
     opts.update(nlp.derivative_options(hessian, blocks_ok))
     recorder = Recorder(nlp.w.numel(), nlp.g.numel(), len(est), scales, 2 * nlp.norm,
@@ -189,9 +197,11 @@ def fit(problem: FitProblem, *, transcription: Transcription = MultipleShooting(
 
 
 def _setup(problem: FitProblem, transcription: Transcription, cost: str, kinds: list[str],
-           blocks_ok: bool, compile_: bool | None, warm_start: FitResult | None):
+           blocks_ok: bool, compile_: bool | None, warm_start: FitResult | None,
+           free: list | None = None):
     """The assembled NLP of ``problem`` and its per-case terms (``kinds``: each case's
-    initial state, "rest", "steady" or "free")."""
+    initial state, "rest", "steady" or "free"; ``free``: per case, where a free initial
+    state's trajectory starts when no warm start gives it)."""
     if compile_ is None:
         from derive._compile import c_compiler
 
@@ -199,6 +209,8 @@ def _setup(problem: FitProblem, transcription: Transcription, cost: str, kinds: 
     scales = np.array([e.scale for e in problem.estimated])
     theta_s = ca.MX.sym("theta", len(problem.estimated))
     warm = _warm_starts(problem, warm_start)
+    if free is not None:
+        warm = [w if w is not None else f for w, f in zip(warm, free)]
     terms = [case_terms(problem, i, theta_s, transcription, cost, kinds[i],
                         blocks_ok, compile_, warm[i]) for i in range(len(problem.experiments))]
     return _Nlp.assemble(theta_s, problem.initial / scales, terms), terms
