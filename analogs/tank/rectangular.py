@@ -31,7 +31,7 @@ from __future__ import annotations
 import math
 from dataclasses import dataclass
 
-from .geometry import _check_positive
+from .geometry import _check_positive, fill_fraction
 
 __all__ = ["Rectangular", "RectangularMode"]
 
@@ -95,17 +95,7 @@ class Rectangular:
                         ) -> float:
         """Liquid depth in m from a depth fraction ``fill`` or a volume fraction
         ``volume_fill`` (the same for vertical walls); give exactly one."""
-        if (fill is None) == (volume_fill is None):
-            raise ValueError("give exactly one of `fill` (depth fraction) and `volume_fill` "
-                             f"(volume fraction); got fill={fill!r}, volume_fill={volume_fill!r}.")
-        name, value = ("fill", fill) if fill is not None else ("volume_fill", volume_fill)
-        try:
-            value = float(value)  # type: ignore[arg-type]
-        except (TypeError, ValueError):
-            raise ValueError(f"`{name}` must be a number in (0, 1); got {value!r}.") from None
-        if not 0.0 < value < 1.0:
-            raise ValueError(f"`{name}` must be a fraction in (0, 1) (exclusive); got {value!r}. "
-                             "Give 60 % as 0.6.")
+        _, value = fill_fraction(fill, volume_fill)  # vertical walls: the same fraction
         return value * self.height
 
     def liquid_mass(self, fill: float, density: float) -> float:

@@ -5,7 +5,8 @@ from __future__ import annotations
 import argparse
 
 from ..outputs import Outputs, json_text
-from ._cases import load_cases, positive_hz as _positive_hz
+from ._cases import load_cases
+from ._cases import positive_hz as _positive_hz
 
 __all__ = ["add_parser"]
 

@@ -106,9 +106,7 @@ def fit(problem: FitProblem, *, transcription: Transcription = MultipleShooting(
         available and the Hessian is Gauss-Newton (multiple shooting only).
     robust_start : bool, default True
         Initialise crank speed corrections from the force spectrum and flywheel angles
-        from a grid over their bounds (:func:`estimate.fitting.initial.crank_start`), and
-        start a free initial state from the state read off the record's first periods
-        (:mod:`estimate.fitting.free_state`).
+        from a grid over their bounds (:func:`estimate.fitting.initial.crank_start`).
     warm_start : FitResult, optional
         A previous fit of the same cases (e.g. of a smaller model): its states start the
         transcription where the coordinates agree and its estimated carriage motion starts
@@ -144,13 +142,7 @@ def fit(problem: FitProblem, *, transcription: Transcription = MultipleShooting(
     scales = np.array([e.scale for e in est])
     # the exact Hessian differentiates g twice: keep g an AD-able expression then
     blocks_ok = hessian.kind == "gauss-newton"
-    free = None
-    if robust_start and "free" in kinds:
-        from .free_state import free_starts
-
-        free = free_starts(problem, kinds)
-    nlp, terms = _setup(problem, transcription, cost, kinds, blocks_ok, compile_, warm_start,
-                        free)
+    nlp, terms = _setup(problem, transcription, cost, kinds, blocks_ok, compile_, warm_start)
     opts = dict(_IPOPT_DEFAULTS)
     opts.update(nlp.derivative_options(hessian, blocks_ok))
     recorder = Recorder(nlp.w.numel(), nlp.g.numel(), len(est), scales, 2 * nlp.norm,
@@ -197,11 +189,9 @@ def fit(problem: FitProblem, *, transcription: Transcription = MultipleShooting(
 
 
 def _setup(problem: FitProblem, transcription: Transcription, cost: str, kinds: list[str],
-           blocks_ok: bool, compile_: bool | None, warm_start: FitResult | None,
-           free: list | None = None):
+           blocks_ok: bool, compile_: bool | None, warm_start: FitResult | None):
     """The assembled NLP of ``problem`` and its per-case terms (``kinds``: each case's
-    initial state, "rest", "steady" or "free"; ``free``: per case, where a free initial
-    state's trajectory starts when no warm start gives it)."""
+    initial state, "rest", "steady" or "free")."""
     if compile_ is None:
         from derive._compile import c_compiler
 
@@ -209,8 +199,6 @@ def _setup(problem: FitProblem, transcription: Transcription, cost: str, kinds: 
     scales = np.array([e.scale for e in problem.estimated])
     theta_s = ca.MX.sym("theta", len(problem.estimated))
     warm = _warm_starts(problem, warm_start)
-    if free is not None:
-        warm = [w if w is not None else f for w, f in zip(warm, free)]
     terms = [case_terms(problem, i, theta_s, transcription, cost, kinds[i],
                         blocks_ok, compile_, warm[i]) for i in range(len(problem.experiments))]
     return _Nlp.assemble(theta_s, problem.initial / scales, terms), terms

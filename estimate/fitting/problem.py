@@ -17,7 +17,7 @@ from ..data.experiment import Experiment, experiment
 from ..data.models import model_for_case
 from ..data.records import refuse_repeated
 from .carriage import CarriageInput, RecordNoise, carriage_input, record_noise
-from .free_state import rest_holds
+from .free_decay import rest_holds
 from .initial import length_bounds, nominal_scale, predicted_sources, source_notes
 
 __all__ = ["FitProblem", "Estimated", "PER_CASE", "INPUT_MODES"]
