@@ -1,9 +1,11 @@
 """Tank modal analysis: analog (pendulum) parameters from tank geometry, fill and liquid.
 
-The linear potential-flow sloshing problem for the lateral (m = 1) modes is solved with a
-converged method (``method="exact"``: Ritz with solid harmonics, or graded axisymmetric
-finite elements) or with the SLOSH code's Lomen basis (``method="legacy"``). Heights are
-measured from the tank bottom on the tank axis, ``z`` up, SI units.
+The linear potential-flow sloshing problem for the lateral (m = 1) modes of an
+axisymmetric tank is solved with a converged method (``method="exact"``: Ritz with solid
+harmonics, or graded axisymmetric finite elements) or with the SLOSH code's Lomen basis
+(``method="legacy"``); an upright rectangular tank's modes are in closed form
+(:mod:`analogs.tank.rectangular`). Heights are measured from the tank bottom on the tank
+axis, ``z`` up, SI units.
 
 Examples
 --------
@@ -26,6 +28,7 @@ from .prediction import (
                          TankPrediction,
                          predict,
 )
+from .rectangular import Rectangular
 
 __all__ = [
     "WATER",
@@ -38,6 +41,7 @@ __all__ = [
     "METHODS",
     "Liquid",
     "Profile",
+    "Rectangular",
     "Ritz",
     "SloshMode",
     "Sphere",

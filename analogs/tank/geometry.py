@@ -62,6 +62,23 @@ class Liquid:
 WATER = Liquid()
 
 
+def fill_fraction(fill: float | None, volume_fill: float | None) -> tuple[str, float]:
+    """``("fill", value)`` or ``("volume_fill", value)``: the one fraction given, checked to
+    lie in (0, 1)."""
+    if (fill is None) == (volume_fill is None):
+        raise ValueError("give exactly one of `fill` (depth fraction) and `volume_fill` "
+                         f"(volume fraction); got fill={fill!r}, volume_fill={volume_fill!r}.")
+    name, value = ("fill", fill) if fill is not None else ("volume_fill", volume_fill)
+    try:
+        value = float(value)  # type: ignore[arg-type]
+    except (TypeError, ValueError):
+        raise ValueError(f"`{name}` must be a number in (0, 1); got {value!r}.") from None
+    if not 0.0 < value < 1.0:
+        raise ValueError(f"`{name}` must be a fraction in (0, 1) (exclusive); got {value!r}. "
+                         "Give 60 % as 0.6.")
+    return name, value
+
+
 # A wall piece: ("line", (r0, z0), (r1, z1)) or ("arc", (rc, zc), radius, angle0, angle1),
 # angles measured from the +r axis, counter-clockwise, running bottom to top.
 _Piece = tuple
@@ -186,22 +203,23 @@ class Tank:
         >>> round(Sphere(0.1).depth_from_fill(volume_fill=0.5), 12)
         0.1
         """
-        if (fill is None) == (volume_fill is None):
-            raise ValueError("give exactly one of `fill` (depth fraction) and `volume_fill` "
-                             f"(volume fraction); got fill={fill!r}, volume_fill={volume_fill!r}.")
-        name, value = ("fill", fill) if fill is not None else ("volume_fill", volume_fill)
-        try:
-            value = float(value)  # type: ignore[arg-type]
-        except (TypeError, ValueError):
-            raise ValueError(f"`{name}` must be a number in (0, 1); got {value!r}.") from None
-        if not 0.0 < value < 1.0:
-            raise ValueError(f"`{name}` must be a fraction in (0, 1) (exclusive); got {value!r}. "
-                             "Give 60 % as 0.6.")
+        name, value = fill_fraction(fill, volume_fill)
         if name == "fill":
             return value * self.height
         target = value * self.volume()
         return float(brentq(lambda h: self.volume(h) - target, 0.0, self.height,
                             xtol=1e-15 * self.height, rtol=1e-15))
+
+    def liquid_mass(self, fill: float, density: float) -> float:
+        """Mass in kg of liquid of ``density`` (kg/m^3) filled to the depth fraction
+        ``fill`` (depth / tank height).
+
+        Examples
+        --------
+        >>> round(Sphere(0.1).liquid_mass(0.5, 1000.0), 6)   # half of a 0.1 m sphere
+        2.094395
+        """
+        return float(density * self.volume(self.depth_from_fill(fill)))
 
     def centroid_height(self, depth: float) -> float:
         """Height in m of the liquid's centre of mass for liquid depth ``depth`` (m)."""

@@ -34,6 +34,7 @@ from . import _fem, _legacy, _ritz
 from ._modes import RawModes
 from .damping import cylinder_damping, damping_validity, sphere_damping
 from .geometry import WATER, Capsule, Cylinder, Liquid, Sphere, Tank
+from .rectangular import Rectangular
 
 __all__ = ["MAX_MODES", "Exact", "FiniteElements", "FixedMassPrediction", "Legacy", "Ritz",
            "SloshMode", "TankPrediction", "predict"]
@@ -232,7 +233,8 @@ class TankPrediction:
 
 
 # -- the problem ---------------------------------------------------------------------------
-def _damping(tank: Tank, depth: float, liquid: Liquid, gravity: float) -> tuple[float, str | None]:
+def _damping(tank: Tank | Rectangular, depth: float, liquid: Liquid, gravity: float
+             ) -> tuple[float, str | None]:
     """The damping ratio and, when the correlation does not hold there, why."""
     nu = liquid.viscosity
     if isinstance(tank, Sphere):
@@ -266,15 +268,17 @@ def _solver(method: str | Solver) -> Solver:
     return method
 
 
-def predict(tank: Tank, *, fill: float | None = None, volume_fill: float | None = None,
+def predict(tank: Tank | Rectangular, *, fill: float | None = None, volume_fill: float | None = None,
             liquid: Liquid = WATER, gravity: float = 9.81, method: str | Solver = "exact",
             modes: int = 2, diaphragm: bool = False) -> TankPrediction:
     """Predict the pendulum analog of lateral slosh for a tank, fill and liquid.
 
     Parameters
     ----------
-    tank : Tank
-        :class:`Sphere`, :class:`Cylinder`, :class:`Capsule` or :class:`Profile`.
+    tank : Tank or Rectangular
+        :class:`Sphere`, :class:`Cylinder`, :class:`Capsule` or :class:`Profile`, solved
+        by ``method``; or an upright :class:`~analogs.tank.rectangular.Rectangular` tank,
+        whose modes are in closed form (``method`` must then be ``"exact"``).
     fill, volume_fill : float
         Liquid depth / tank height, or liquid volume / tank volume, in (0, 1); give one.
     liquid : Liquid
@@ -300,9 +304,9 @@ def predict(tank: Tank, *, fill: float | None = None, volume_fill: float | None 
     >>> round(p.modes[0].lam * 0.1016, 4)
     1.5602
     """
-    if not isinstance(tank, Tank):
-        raise ValueError("`tank` must be a Sphere, Cylinder, Capsule or Profile; got "
-                         f"{tank!r}.")
+    if not isinstance(tank, (Tank, Rectangular)):
+        raise ValueError("`tank` must be a Sphere, Cylinder, Capsule, Profile or Rectangular; "
+                         f"got {tank!r}.")
     gravity_ = float(gravity) if isinstance(gravity, (int, float)) else float("nan")
     if not (math.isfinite(gravity_) and gravity_ > 0):
         raise ValueError(f"`gravity` must be a positive acceleration in m/s^2; got {gravity!r}.")
@@ -312,26 +316,34 @@ def predict(tank: Tank, *, fill: float | None = None, volume_fill: float | None 
         raise ValueError(f"`liquid` must be a Liquid(density=..., viscosity=...); got {liquid!r}.")
     solver = _solver(method)
     depth = tank.depth_from_fill(fill, volume_fill=volume_fill)
+    rho, g = liquid.density, gravity_
+    zeta, validity = _damping(tank, depth, liquid, g)
 
     t0 = time.perf_counter()
-    raw = solver.solve(tank, depth, modes)
+    if isinstance(tank, Rectangular):
+        if solver.name != "exact":
+            raise ValueError(f"a rectangular tank's modes are in closed form: `method` must be "
+                             f"\"exact\"; got {solver.name!r}.")
+        terms = [(m.lam, rho * m.volume, m.bob_height, m.amplitude_ratio)
+                 for m in tank.modes(depth, modes)]
+        used, size = "closed form", 0
+    else:
+        raw = solver.solve(tank, depth, modes)
+        used = solver.choose(tank, depth).name if isinstance(solver, Exact) else solver.name
+        terms = [(raw.lam[n], rho * math.pi * raw.lam[n] * raw.a[n] ** 2 / raw.b[n],
+                  raw.moment[n] / (raw.lam[n] * raw.a[n]),
+                  raw.lam[n] * raw.u_wall[n] * raw.a[n] / raw.b[n]) for n in range(modes)]
+        size = raw.size
     seconds = time.perf_counter() - t0
-    used = solver.choose(tank, depth).name if isinstance(solver, Exact) else solver.name
 
-    rho, g = liquid.density, gravity_
     volume = tank.volume(depth)
     m_liq = rho * volume
     z_cg = tank.centroid_height(depth)
-    zeta, validity = _damping(tank, depth, liquid, g)
-    out = []
-    for n in range(modes):
-        lam, a, b = raw.lam[n], raw.a[n], raw.b[n]
-        bob = raw.moment[n] / (lam * a)
-        out.append(SloshMode(
-            index=n + 1, frequency_hz=math.sqrt(lam * g) / (2.0 * math.pi), lam=float(lam),
-            mass=float(rho * math.pi * lam * a * a / b), length=float(1.0 / lam),
-            hinge_height=float(bob + 1.0 / lam), bob_height=float(bob),
-            amplitude_ratio=float(lam * raw.u_wall[n] * a / b), damping_ratio=zeta))
+    out = [SloshMode(index=n + 1, frequency_hz=math.sqrt(lam * g) / (2.0 * math.pi),
+                     lam=float(lam), mass=float(mass), length=float(1.0 / lam),
+                     hinge_height=float(bob + 1.0 / lam), bob_height=float(bob),
+                     amplitude_ratio=float(ratio), damping_ratio=zeta)
+           for n, (lam, mass, bob, ratio) in enumerate(terms)]
     m0 = m_liq - sum(m.mass for m in out)
     h0 = (m_liq * z_cg - sum(m.mass * m.bob_height for m in out)) / m0
     inertia = rho * tank.rigid_inertia(depth, h0) - sum(m.mass * (m.bob_height - h0) ** 2
@@ -341,7 +353,8 @@ def predict(tank: Tank, *, fill: float | None = None, volume_fill: float | None 
         notes.append("diaphragm: this is the free-surface prediction; a diaphragm raises the "
                      "frequency, lowers the slosh mass and adds damping - estimate them from data")
     if not math.isfinite(zeta):
-        notes.append("no damping correlation for a general profile: damping_ratio is nan")
+        what = "general profile" if tank.shape == "profile" else f"{tank.shape} tank"
+        notes.append(f"no damping correlation for a {what}: damping_ratio is nan")
     if validity:
         notes.append(validity)
     if isinstance(solver, Legacy):
@@ -352,4 +365,4 @@ def predict(tank: Tank, *, fill: float | None = None, volume_fill: float | None 
         liquid_mass=float(m_liq), liquid_cg_height=float(z_cg), method=solver.name,
         solver=used, modes=tuple(out),
         fixed_mass=FixedMassPrediction(mass=float(m0), height=float(h0), inertia=float(inertia)),
-        diaphragm=bool(diaphragm), size=raw.size, seconds=seconds, notes=tuple(notes))
+        diaphragm=bool(diaphragm), size=size, seconds=seconds, notes=tuple(notes))

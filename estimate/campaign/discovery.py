@@ -26,6 +26,7 @@ from __future__ import annotations
 import fnmatch
 import glob
 import hashlib
+import math
 import os
 from collections.abc import Mapping
 from dataclasses import dataclass
@@ -34,6 +35,7 @@ from typing import Any
 
 from analogs.errors import InputError
 
+from ..data.case import SHAPE_KEYS
 from ..data.models import BASELINE
 from ..data.reader import MAX_CASE_FILE_BYTES
 from ..fitting.problem import INPUT_MODES
@@ -49,9 +51,10 @@ _GROUP_KEYS = {"records", "model"}
 
 @dataclass(frozen=True)
 class Setup:
-    """What makes records one group: rig kind, ``[tank]`` (shape, radius in m, fill
-    fraction, diaphragm) and ``[liquid]`` (density in kg/m^3, kinematic viscosity in
-    m^2/s), and ``[rig] gravity`` (m/s^2) for the tank prediction."""
+    """What makes records one group: rig kind, ``[tank]`` (shape, radius in m - NaN for a
+    rectangular tank -, fill fraction, diaphragm, the shape's other sizes in m) and
+    ``[liquid]`` (density in kg/m^3, kinematic viscosity in m^2/s), and ``[rig] gravity``
+    (m/s^2) for the tank prediction."""
 
     rig: str
     shape: str
@@ -61,12 +64,31 @@ class Setup:
     density: float
     viscosity: float
     gravity: float
+    #: ``[tank]`` sizes besides the radius (``(("length", 0.3),)`` for a cylinder), m.
+    sizes: tuple[tuple[str, float], ...] = ()
 
     @property
     def series(self) -> tuple:
         """The setup without the fill: records of one series lie on one prediction curve."""
-        return (self.rig, self.shape, self.radius, self.diaphragm, self.density,
+        return (self.rig, self.shape, self.radius, self.sizes, self.diaphragm, self.density,
                 self.viscosity, self.gravity)
+
+    def geometry(self):
+        """The tank as an :mod:`analogs.tank` geometry (see
+        :meth:`estimate.data.case.Tank.geometry`)."""
+        from ..data.case import Tank
+
+        radius = None if math.isnan(self.radius) else self.radius
+        return Tank(self.shape, radius, self.fill_fraction, self.diaphragm,
+                    **dict(self.sizes)).geometry()
+
+    @property
+    def size_name(self) -> str:
+        """``R0.1016`` (axisymmetric), ``0.4x0.2x0.3`` (rectangular), plus other sizes."""
+        head = [] if math.isnan(self.radius) else [f"R{self.radius:g}"]
+        if self.shape == "rectangular":
+            return "x".join(f"{v:g}" for _, v in self.sizes)
+        return "-".join(head + [f"{k}{v:g}" for k, v in self.sizes])
 
 
 @dataclass(frozen=True)
@@ -156,8 +178,12 @@ def _read_toml(path: Path) -> dict[str, Any] | None:
 def _setup(doc: Mapping[str, Any]) -> Setup | None:
     try:
         test, tank, liquid, rig = (doc[k] for k in ("test", "tank", "liquid", "rig"))
-        return Setup(rig=str(test.get("rig", "lateral")), shape=str(tank["shape"]),
-                     radius=float(tank["radius"]), fill_fraction=float(tank["fill_fraction"]),
+        shape = str(tank["shape"])
+        sizes = tuple((k, float(tank[k])) for k in SHAPE_KEYS.get(shape, ("radius",))
+                      if k != "radius")
+        return Setup(rig=str(test.get("rig", "lateral")), shape=shape,
+                     radius=float(tank.get("radius", math.nan)), sizes=sizes,
+                     fill_fraction=float(tank["fill_fraction"]),
                      diaphragm=bool(tank.get("diaphragm", False)),
                      density=float(liquid["density"]),
                      viscosity=float(liquid["kinematic_viscosity"]),
@@ -207,7 +233,7 @@ def _group_names(keys: list[Setup]) -> list[str]:
                if len({getattr(k, f) for k in keys}) > 1]
     names = []
     for k in keys:
-        name = f"{k.shape}-R{k.radius:g}-fill{k.fill_fraction:g}"
+        name = f"{k.shape}-{k.size_name}-fill{k.fill_fraction:g}"
         for f in varying:
             v = getattr(k, f)
             name += (f"-{v}" if f == "rig" else "-diaphragm" if f == "diaphragm" and v

@@ -126,7 +126,7 @@ def plot_against_fill(table: CampaignTable, curves: Sequence[PredictionCurves],
     for (ax, dev), q in zip(pairs, quantities):
         unit = table.quantities[q]
         for i, c in enumerate(curves):
-            tag = "" if len(curves) == 1 else f" ({c.setup.shape} R {c.setup.radius:g} m)"
+            tag = "" if len(curves) == 1 else f" ({c.setup.shape} {c.setup.size_name})"
             exact = c.values.get("exact", {}).get(q)
             for method, style in (("exact", "-"), ("legacy", "--")):
                 if q in c.values.get(method, {}):

@@ -38,7 +38,7 @@ def predicted(setup: Setup, fill: float, *, pendulums: int, method: str) -> dict
     """Predicted ``fixed.mass`` (kg) and, per pendulum ``pN``, ``mass`` (kg), ``length``
     (m), ``frequency_hz`` (Hz) and ``damping_ratio`` (-) at ``fill`` (cached: do not
     modify the returned dict)."""
-    p = tank_prediction(setup.shape, setup.radius, fill, density=setup.density,
+    p = tank_prediction(setup.geometry(), fill, density=setup.density,
                         viscosity=setup.viscosity, gravity=setup.gravity,
                         modes=max(pendulums, 1), method=method, diaphragm=setup.diaphragm)
     out = {"fixed.mass": p.fixed_mass.mass}

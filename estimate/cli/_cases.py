@@ -3,12 +3,13 @@
 from __future__ import annotations
 
 from collections.abc import Sequence
+from dataclasses import replace
 from typing import TYPE_CHECKING
 
 if TYPE_CHECKING:  # the parser of every command imports this module: load nothing yet
     from ..data import Case
 
-__all__ = ["add_strict", "load_cases"]
+__all__ = ["add_strict", "load_cases", "positive_hz"]
 
 
 def add_strict(parser) -> None:
@@ -18,19 +19,22 @@ def add_strict(parser) -> None:
                              "naming the key and the nearest known name)")
 
 
-def load_cases(paths: Sequence[str], *, prediction: bool = False, strict: bool = False
-               ) -> tuple[list["Case"], list[str]]:
+def load_cases(paths: Sequence[str], *, prediction: bool = False, strict: bool = False,
+               motion_band_hz: float | None = None) -> tuple[list["Case"], list[str]]:
     """The cases of ``paths`` and warnings about them (``strict``: unknown keys are errors,
     :func:`estimate.data.load_case`).
 
     A record given twice is refused (:func:`estimate.data.records.refuse_repeated`);
     ``prediction``: a ``[prediction]`` that contradicts the tank's own modal prediction is
-    a warning (:func:`estimate.fitting.initial.prediction_conflicts`).
+    a warning (:func:`estimate.fitting.initial.prediction_conflicts`); ``motion_band_hz``
+    (``--motion-band``, Hz) replaces every case's ``[test] motion_band_hz``.
     """
     from ..data import load_case
     from ..data.records import refuse_repeated
 
     cases = [load_case(p, strict=strict) for p in paths]
+    if motion_band_hz is not None:
+        cases = [replace(c, test=replace(c.test, motion_band_hz=motion_band_hz)) for c in cases]
     refuse_repeated(cases)
     notes: list[str] = []
     if prediction:
@@ -39,3 +43,17 @@ def load_cases(paths: Sequence[str], *, prediction: bool = False, strict: bool =
         for case in cases:
             notes += prediction_conflicts(case)
     return cases, notes
+
+
+def positive_hz(text: str) -> float:
+    """An argparse type: a positive finite frequency in Hz."""
+    import argparse
+    import math
+
+    try:
+        value = float(text)
+    except ValueError:
+        raise argparse.ArgumentTypeError(f"expected a frequency in Hz, found {text!r}") from None
+    if not (math.isfinite(value) and value > 0):
+        raise argparse.ArgumentTypeError(f"expected a positive frequency in Hz, found {text!r}")
+    return value

@@ -6,6 +6,7 @@ import argparse
 
 from ..outputs import Outputs, json_text
 from ._cases import add_strict, load_cases
+from ._cases import positive_hz as _positive_hz
 
 __all__ = ["add_parser"]
 
@@ -20,6 +21,11 @@ def add_parser(sub: argparse._SubParsersAction) -> None:
     p.add_argument("cases", nargs="+", help="test case files (TOML)")
     p.add_argument("--json", dest="json_out", required=True, help="write the diagnosis as JSON")
     p.add_argument("--report", default=None, help="write the report folder (plots, Markdown)")
+    p.add_argument("--motion-band", type=_positive_hz, default=None, metavar="HZ",
+                   help="highest frequency of the carriage motion (Hz): sets the estimated "
+                        "carriage spline's knot spacing and the filtered input's displacement "
+                        "cutoff; default: the case's [test] motion_band_hz, else read from the "
+                        "displacement (a carriage at rest needs none)")
     p.add_argument("--overwrite", action="store_true", help="replace existing output files")
     add_strict(p)
     p.set_defaults(run=run)
@@ -33,7 +39,8 @@ def run(args: argparse.Namespace) -> int:
 
     outputs = Outputs(overwrite=args.overwrite, inputs=args.cases)
     outputs.file("--json", args.json_out).folder("--report", args.report, REPORT_FILES).check()
-    cases, notes = load_cases(args.cases, prediction=True, strict=args.strict)
+    cases, notes = load_cases(args.cases, prediction=True, strict=args.strict,
+                              motion_band_hz=args.motion_band)
     for w in notes:
         print(f"warning: {w}", file=sys.stderr)
     d = diagnose(cases)

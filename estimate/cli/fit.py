@@ -6,6 +6,7 @@ import argparse
 
 from ..outputs import Outputs, json_text
 from ._cases import add_strict, load_cases
+from ._cases import positive_hz as _positive_hz
 
 __all__ = ["add_parser"]
 
@@ -34,6 +35,11 @@ def add_parser(sub: argparse._SubParsersAction) -> None:
     p.add_argument("--json", dest="json_out", default=None, help="write the result as JSON")
     p.add_argument("--plot", default=None, help="write the fit plots (PNG) of the first case")
     p.add_argument("--report", action="store_true", help="print the full text fit report")
+    p.add_argument("--motion-band", type=_positive_hz, default=None, metavar="HZ",
+                   help="highest frequency of the carriage motion (Hz): sets the estimated "
+                        "carriage spline's knot spacing and the filtered input's displacement "
+                        "cutoff; default: the case's [test] motion_band_hz, else read from the "
+                        "displacement (a carriage at rest needs none)")
     p.add_argument("--overwrite", action="store_true", help="replace existing output files")
     add_strict(p)
     p.set_defaults(run=run)
@@ -50,7 +56,8 @@ def run(args: argparse.Namespace) -> int:
 
     outputs = Outputs(overwrite=args.overwrite, inputs=args.cases)
     outputs.file("--json", args.json_out).file("--plot", args.plot).check()
-    cases, notes = load_cases(args.cases, prediction=True, strict=args.strict)
+    cases, notes = load_cases(args.cases, prediction=True, strict=args.strict,
+                              motion_band_hz=args.motion_band)
     for w in notes:  # before the fit, which starts from [prediction]
         print(f"warning: {w}", file=sys.stderr)
     spec = BASELINE if args.model is None else args.model
@@ -71,6 +78,9 @@ def run(args: argparse.Namespace) -> int:
             print(f"  {n:30s} {v:.6g} {u} {result.uncertainty_text(i)}")
         for c in result.confounded():
             print(f"  note: {c}")
+        for case in cases:  # what loading did to the record ([test] resample_hz)
+            for n in case.notes:
+                print(f"  note: {n}")
     for w in result.warnings:
         print(f"warning: {w}", file=sys.stderr)
     with outputs.writing() as paths:

@@ -9,13 +9,13 @@ from __future__ import annotations
 import argparse
 
 from analogs.errors import InputError
-from analogs.tank import Capsule, Cylinder, Liquid, Sphere, predict
+from analogs.tank import Capsule, Cylinder, Liquid, Rectangular, Sphere, predict
 
 from ..outputs import Outputs, json_text
 
 __all__ = ["add_parser", "run"]
 
-_SHAPES = ("sphere", "cylinder", "capsule")
+_SHAPES = ("sphere", "cylinder", "capsule", "rectangular")
 
 
 def add_parser(subparsers: argparse._SubParsersAction) -> None:
@@ -23,11 +23,17 @@ def add_parser(subparsers: argparse._SubParsersAction) -> None:
     p = subparsers.add_parser(
         "tank", help="predict slosh analog parameters from tank geometry and fill",
         description="Lateral slosh modes of an axisymmetric tank as pendulums (SI units, "
-                    "heights from the tank bottom).")
+                    "heights from the tank bottom); an upright rectangular tank in closed form.")
     p.add_argument("--shape", choices=_SHAPES, default="sphere", help="tank shape")
-    p.add_argument("--radius", type=float, required=True, help="inside radius, m")
+    p.add_argument("--radius", type=float, default=None,
+                   help="inside radius, m (sphere, cylinder, capsule)")
     p.add_argument("--length", type=float, default=None,
-                   help="cylinder height, or capsule cylindrical length, m")
+                   help="cylinder height, capsule cylindrical length, or rectangular tank's "
+                        "length along the motion, m")
+    p.add_argument("--width", type=float, default=None,
+                   help="rectangular tank: inside width across the motion, m")
+    p.add_argument("--height", type=float, default=None,
+                   help="rectangular tank: inside height, m")
     fill = p.add_mutually_exclusive_group(required=True)
     fill.add_argument("--fill", type=float, help="liquid depth / tank height, in (0, 1)")
     fill.add_argument("--volume-fill", type=float, help="liquid volume / tank volume, in (0, 1)")
@@ -46,10 +52,19 @@ def add_parser(subparsers: argparse._SubParsersAction) -> None:
 
 
 def _tank(args: argparse.Namespace):
+    needed = (("length", "width", "height") if args.shape == "rectangular"
+              else ("radius",) if args.shape == "sphere" else ("radius", "length"))
+    missing = [f"`--{k}`" for k in needed if getattr(args, k) is None]
+    stray = [f"`--{k}`" for k in ("radius", "length", "width", "height")
+             if k not in needed and getattr(args, k) is not None]
+    if missing or stray:
+        raise InputError(f"--shape {args.shape} takes " + ", ".join(f"`--{k}`" for k in needed)
+                         + " (m); " + (f"got none for {', '.join(missing)}" if missing else
+                                       f"{', '.join(stray)} does not apply"))
+    if args.shape == "rectangular":
+        return Rectangular(args.length, args.width, args.height)
     if args.shape == "sphere":
         return Sphere(args.radius)
-    if args.length is None:
-        raise InputError(f"`--length` (m) is required for --shape {args.shape}; got none.")
     if args.shape == "cylinder":
         return Cylinder(args.radius, args.length)
     return Capsule(args.radius, args.length)
@@ -97,6 +112,9 @@ def _plot(args: argparse.Namespace, tank, liquid: Liquid, path: str, pred) -> No
     zeta = np.array([r.modes[0].damping_ratio for r in rows])
     ax[2].plot(pct, zeta, "-o", ms=3, color="C2", label="damping ratio (all modes)")
     ax[2].set(ylabel="damping ratio [-]", xlabel="fill [% of tank height]", xlim=(0, 100))
+    if not np.any(np.isfinite(zeta)):  # a rectangular tank or a general profile
+        ax[2].text(0.5, 0.5, f"no damping correlation for a {args.shape} tank",
+                   transform=ax[2].transAxes, ha="center", va="center", color="0.4")
     # what the reader should not trust: the legacy basis above half full, damping outside
     # its correlation's data
     if args.method == "legacy":
@@ -125,7 +143,9 @@ def _plot(args: argparse.Namespace, tank, liquid: Liquid, path: str, pred) -> No
     top.set_xlabel("fill [% of tank volume]")
     for a in ax:
         a.legend(loc="best", fontsize="small")
-    fig.suptitle(f"{args.shape}, radius {args.radius:g} m, height {tank.height:.4g} m\n"
+    size = (f"{args.length:g} x {args.width:g} m" if args.shape == "rectangular"
+            else f"radius {args.radius:g} m")
+    fig.suptitle(f"{args.shape}, {size}, height {tank.height:.4g} m\n"
                  f"{liquid.density:g} kg/m^3, g = {args.gravity:g} m/s^2, method {args.method}",
                  fontsize="medium")
     fig.savefig(path, dpi=120)
@@ -133,7 +153,7 @@ def _plot(args: argparse.Namespace, tank, liquid: Liquid, path: str, pred) -> No
 
 
 #: Unit of each numeric option (ranges: :data:`estimate.data.case.PHYSICAL_RANGES`).
-_UNITS = {"radius": "m", "length": "m", "density": "kg/m^3", "viscosity": "m^2/s",
+_UNITS = {"radius": "m", "length": "m", "width": "m", "height": "m", "density": "kg/m^3", "viscosity": "m^2/s",
           "gravity": "m/s^2"}
 
 

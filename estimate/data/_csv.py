@@ -75,13 +75,15 @@ def _python_only(text: str) -> bool:
 
 
 def read_csv(path: Path, excitation: str | None, problems: list[str],
-              rig_kind: str | None = "lateral") -> tuple[Any, ...] | None:
+              rig_kind: str | None = "lateral", *, uniform: bool = True
+              ) -> tuple[Any, ...] | None:
     """Read and check the CSV; append problems; return (time, displacement, force, columns)
     or None (``columns``: the non-time columns of a spinning-rig CSV, else empty).
 
     The file is streamed: a record with more samples than the memory budget allows
     (:mod:`estimate.data.budget`) is refused before its arrays are allocated. A UTF-8 byte
-    order mark (Excel's "CSV UTF-8") is accepted.
+    order mark (Excel's "CSV UTF-8") is accepted. ``uniform=False`` accepts a time column
+    that is not uniform (``[test] resample_hz``).
     """
     name = path.name
     try:
@@ -92,7 +94,7 @@ def read_csv(path: Path, excitation: str | None, problems: list[str],
         with io.TextIOWrapper(open_input(path, "a CSV file"), newline="",
                               encoding="utf-8-sig") as fh:
             return _read_rows(csv.reader(fh), n_lines, name, excitation, problems, rig_kind,
-                              ended=ended)
+                              ended=ended, uniform=uniform)
     except InputError as exc:  # replaced by a pipe or a device since it was checked
         problems.append(f"{name}: {str(exc).split(': ', 1)[-1]}")
         return None
@@ -111,7 +113,8 @@ def _rows(reader) -> Iterator[tuple[int, list[str]]]:
 
 
 def _read_rows(reader, n_lines: int, name: str, excitation: str | None, problems: list[str],
-               rig_kind: str | None, *, ended: bool = True) -> tuple[Any, ...] | None:
+               rig_kind: str | None, *, ended: bool = True, uniform: bool = True
+               ) -> tuple[Any, ...] | None:
     rows = _rows(reader)
     first = next(rows, None)
     spinning = rig_kind == "spinning"
@@ -215,7 +218,7 @@ def _read_rows(reader, n_lines: int, name: str, excitation: str | None, problems
                             f"digits, which only Python reads: {_values_text(odd)}")
     skip = {col: skip_lines | {ln for ln, _ in bad_numbers[col]} for col in names}
     check_samples(name, names, data, problems, row=lambda i: int(lines[i]), where=_rows_text,
-                  skip=skip)
+                  skip=skip, uniform=uniform)
     t = data[:, 0]
     if len(problems) > 0:
         return None

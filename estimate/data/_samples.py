@@ -30,7 +30,7 @@ def rows_text(rows: Sequence[int], word: str = "line", plural: str | None = None
 def check_samples(name: str, columns: Sequence[str], data: NDArray[np.float64], problems: list[str],
                   *, row: Callable[[int], int], where: Callable[[list[int]], str],
                   skip: Mapping[str, Collection[int]] | None = None, kind: str = "column",
-                  quantities: Sequence[str] | None = None) -> None:
+                  quantities: Sequence[str] | None = None, uniform: bool = True) -> None:
     """Append the problems of the samples ``data`` (one column per name in ``columns``, the
     first the time in s) of the file ``name``.
 
@@ -40,6 +40,7 @@ def check_samples(name: str, columns: Sequence[str], data: NDArray[np.float64], 
     ("column" of a CSV, "channel" of a lab file); ``quantities`` are the case's column
     names of the columns (default ``columns``): a displacement, force or torque beyond
     :data:`~estimate.data.case.PHYSICAL_RANGES` (a force of 1e300 N) is refused.
+    ``uniform=False`` (``[test] resample_hz``) accepts steps that are not uniform.
     """
     for j, col in enumerate(columns):
         known = (skip or {}).get(col, ())
@@ -75,7 +76,7 @@ def check_samples(name: str, columns: Sequence[str], data: NDArray[np.float64], 
         problems.append(f"{name}: {kind} `{columns[0]}`: expected a record of at least "
                         f"{MIN_DURATION:g} s (times in seconds), found {t[-1] - t[0]:.3g} s "
                         f"({n} samples at a step of {float(np.median(dt)):.3g} s)")
-    else:
+    elif uniform:
         step = float(np.median(dt))
         off = np.flatnonzero(np.abs(dt - step) > TIME_STEP_RTOL * step)
         if off.size:
@@ -85,4 +86,5 @@ def check_samples(name: str, columns: Sequence[str], data: NDArray[np.float64], 
                 f"{name}: {kind} `{columns[0]}`: expected a uniform step (median {step:.6g} s, "
                 f"tolerance {TIME_STEP_RTOL:g} relative), found {off.size} step(s) off at "
                 f"{where(at)} (worst: a step of {dt[worst]:.6g} s ending at "
-                f"{where([row(worst + 1)])})")
+                f"{where([row(worst + 1)])}); receive-time or jittered timestamps: give "
+                "`[test] resample_hz` (Hz) to bring the record onto a uniform time base")

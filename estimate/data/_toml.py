@@ -13,6 +13,7 @@ from .case import (
     KNOWN_RIGS,
     KNOWN_SHAPES,
     PHYSICAL_RANGES,
+    SHAPE_KEYS,
     SPIN_COLUMN_KEYS,
     TANK_AXES,
     Crank,
@@ -150,6 +151,11 @@ def _read_test(ck: Checker, doc: Mapping[str, Any]) -> TestInfo | None:
     bad_rest = "starts_at_rest" in t and at_rest is None
     initial = ck.string(t, "test", "initial_state", choices=KNOWN_INITIAL_STATES, required=False)
     bad_rest = bad_rest or ("initial_state" in t and initial is None)
+    rates = {}
+    for key in ("resample_hz", "motion_band_hz"):
+        if key in t:
+            rates[key] = ck.number(t, "test", key, unit="Hz", positive=True)
+            bad_rest = bad_rest or rates[key] is None
     if data is not None and not data.strip():
         ck.add("[test] data", 'expected a CSV path, found an empty string ""')
         data = None
@@ -158,7 +164,7 @@ def _read_test(ck: Checker, doc: Mapping[str, Any]) -> TestInfo | None:
     assert test_id is not None and rig is not None and data is not None
     assert excitation is not None
     return TestInfo(id=test_id, rig=rig, data=data, excitation=excitation, note=note,
-                    starts_at_rest=at_rest, initial_state=initial)
+                    starts_at_rest=at_rest, initial_state=initial, **rates)
 
 
 def _read_tank(ck: Checker, doc: Mapping[str, Any]) -> Tank | None:
@@ -166,12 +172,54 @@ def _read_tank(ck: Checker, doc: Mapping[str, Any]) -> Tank | None:
     if t is None:
         return None
     shape = ck.string(t, "tank", "shape", choices=KNOWN_SHAPES)
-    radius = ck.number(t, "tank", "radius", unit="m", positive=True)
     fill = ck.number(t, "tank", "fill_fraction", unit="-", open_unit_interval=True)
     diaphragm = ck.boolean(t, "tank", "diaphragm")
-    if shape is None or radius is None or fill is None or diaphragm is None:
+    if shape is None:  # the sizes given are still checked as lengths
+        # `key in t`, not `set(t)`: iterating the table would hide its unknown keys
+        for key in sorted(k for k in _ALL_SIZE_KEYS if k in t):
+            ck.number(t, "tank", key, unit="m", nonnegative=True)
         return None
-    return Tank(shape=shape, radius=radius, fill_fraction=fill, diaphragm=diaphragm)
+    needed = SHAPE_KEYS[shape]
+    sizes: dict[str, float | None] = {}
+    for key in needed:
+        if key not in t:
+            ck.add(f"[tank] {key}", f"missing key (expected {_SIZE_MEANING[key]} in m for "
+                   f'`shape = "{shape}"`{_SIZE_HINT.get((shape, key), "")})')
+            sizes[key] = None
+            continue
+        sizes[key] = ck.number(t, "tank", key, unit="m", positive=key != "cylinder_length",
+                               nonnegative=key == "cylinder_length")
+    for key in sorted(_ALL_SIZE_KEYS - set(needed)):
+        if key in t:
+            users = [s for s, keys in SHAPE_KEYS.items() if key in keys]
+            ck.add(f"[tank] {key}", f'not a size of a {shape} (expected only '
+                   + ", ".join(f"`{k}`" for k in needed) + f' for `shape = "{shape}"`; `{key}` '
+                   f'belongs to {_and(users)} tanks)' + _MISPLACED_HINT.get((shape, key), ""))
+            sizes[key] = None
+    if fill is None or diaphragm is None or any(v is None for v in sizes.values()):
+        return None
+    return Tank(shape=shape, radius=sizes.get("radius"), fill_fraction=fill, diaphragm=diaphragm,
+                length=sizes.get("length"), cylinder_length=sizes.get("cylinder_length"),
+                width=sizes.get("width"), height=sizes.get("height"))
+
+
+_SIZE_MEANING = {"radius": "the inside radius", "length": "the inside length",
+                 "cylinder_length": "the length of the straight section between the domes",
+                 "width": "the inside width across the motion", "height": "the inside height"}
+_SIZE_HINT = {("cylinder", "length"): ": the inside height, which the fill fraction is "
+                                      "measured against (no longer assumed equal to the "
+                                      "diameter)",
+              ("rectangular", "length"): ": along the motion",
+              ("capsule", "cylinder_length"): "; 0 for a sphere, the inside height is "
+                                              "`cylinder_length + 2 radius`"}
+_MISPLACED_HINT = {("capsule", "length"): "; a capsule's straight section is "
+                                          "`cylinder_length` (inside height "
+                                          "`cylinder_length + 2 radius`)"}
+_ALL_SIZE_KEYS = {k for keys in SHAPE_KEYS.values() for k in keys}
+
+
+def _and(words: list[str]) -> str:
+    return words[0] if len(words) == 1 else ", ".join(words[:-1]) + " and " + words[-1]
 
 
 def _read_liquid(ck: Checker, doc: Mapping[str, Any]) -> Liquid | None:

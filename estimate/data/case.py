@@ -9,12 +9,17 @@ CSV file with the measured samples. The format is the one of the estimation issu
     data = "A1.csv"              # CSV path relative to this file
     excitation = "measured"      # "measured": CSV has displacement; "crank": from [rig.crank]
     starts_at_rest = true        # optional; absent: detected from the first 0.1 s
+    resample_hz = 500.0          # optional: timestamps that jitter; see below
 
     [tank]
-    shape = "sphere"             # "sphere" | "cylinder"
-    radius = 0.1016              # m
+    shape = "sphere"             # "sphere" | "cylinder" | "capsule" | "rectangular"
+    radius = 0.1016              # m (sphere, cylinder, capsule)
     fill_fraction = 0.6          # liquid depth / tank height
     diaphragm = false
+    # length = 0.3               # m: cylinder inside height; rectangular: along the motion
+    # cylinder_length = 0.1      # m: capsule, straight section between the domes
+    # width = 0.2                # m: rectangular, across the motion
+    # height = 0.3               # m: rectangular, inside height
 
     [liquid]
     density = 998.2              # kg/m^3
@@ -103,12 +108,23 @@ needs are required there, every key present must be a positive number)::
     nutation_frequency = 1.0     # Hz, spinning rig: largest coning frequency (either sign)
     cone_angle = 0.1             # rad, spinning rig: largest cone half-angle
 
+Timestamps and the carriage motion's band
+-----------------------------------------
+``[test] resample_hz = 500.0`` accepts timestamps that are not uniform (receive times that
+jitter, a polled logger) and brings the record onto a uniform time base at that rate
+(:mod:`estimate.data.timebase`: receive times of a clocked stream are placed on the line
+through them, truly irregular samples are interpolated); what was done is kept in
+:attr:`Case.notes` and printed in the fit report. ``[test] motion_band_hz`` (Hz, optional)
+gives the highest frequency of the carriage motion when the record cannot tell it (see
+:func:`estimate.data.signals.motion_band`); ``slosh fit --motion-band`` sets it too.
+
 Validation limits
 -----------------
 * Time must increase strictly and be uniform: every step must be within
   :data:`TIME_STEP_RTOL` (1e-3) of the median step, relative. This admits timestamps printed
   with a few decimals and floating-point round-off, and rejects dropped or repeated samples
-  (a dropped sample is a 100% step error).
+  (a dropped sample is a 100% step error). ``[test] resample_hz`` lifts the uniformity
+  check (see above).
 * At least :data:`MIN_SAMPLES` (50) samples: fewer cannot hold a few periods of a 1-5 Hz drive at
   100 Hz sampling, nor the padding that zero-phase filters and Welch spectra need.
 * At least :data:`MIN_DURATION` (0.1 s): a shorter record cannot hold one period of a slosh
@@ -146,6 +162,7 @@ __all__ = [
     "Prediction",
     "Rig",
     "SPINNING_CHANNELS",
+    "SHAPE_KEYS",
     "SPIN_COLUMN_KEYS",
     "Spin",
     "Tank",
@@ -166,7 +183,7 @@ KNOWN_INITIAL_STATES: tuple[str, ...] = ("rest", "steady", "free")
 """Values accepted for ``[test] initial_state``."""
 SPIN_COLUMN_KEYS: tuple[str, ...] = ("spin_angle", "spin_rate", "nutation_phase", "cone_angle")
 """Keys of ``[rig.spin]`` that name CSV columns of measured rig motion."""
-KNOWN_SHAPES: tuple[str, ...] = ("sphere", "cylinder")
+KNOWN_SHAPES: tuple[str, ...] = ("sphere", "cylinder", "capsule", "rectangular")
 """Values accepted for ``[tank] shape``."""
 MIN_SAMPLES: int = 50
 """Minimum number of CSV samples (see the module docstring for why)."""
@@ -249,6 +266,14 @@ class TestInfo:
     initial_state : str or None
         ``[test] initial_state``, one of :data:`KNOWN_INITIAL_STATES`: where the liquid
         (the analog's coordinates) starts; ``None`` (absent) means ``"rest"``.
+    resample_hz : float or None
+        ``[test] resample_hz``: the timestamps need not be uniform; the record is brought
+        onto a uniform time base at this rate [Hz] (:mod:`estimate.data.timebase`).
+    motion_band_hz : float or None
+        ``[test] motion_band_hz``: the highest frequency of the carriage motion [Hz],
+        which sets the displacement filter's cutoff (filtered input) and the carriage
+        spline's knot spacing (estimated input); ``None``: chosen from the record
+        (:func:`estimate.data.signals.motion_band`).
     """
 
     __test__ = False  # not a pytest test class despite the name
@@ -260,28 +285,83 @@ class TestInfo:
     note: str | None = None
     starts_at_rest: bool | None = None
     initial_state: str | None = None
+    resample_hz: float | None = None
+    motion_band_hz: float | None = None
 
 
 @dataclass(frozen=True)
 class Tank:
     """The ``[tank]`` table.
 
+    Which size keys a shape needs (m): ``sphere`` its ``radius``; ``cylinder`` (upright,
+    flat bottom and top) its ``radius`` and inside height ``length``; ``capsule`` (a
+    cylinder with hemispherical ends, upright) its ``radius`` and the length of its
+    straight section ``cylinder_length`` (inside height ``cylinder_length + 2 radius``);
+    ``rectangular`` (an upright box) its inside ``length`` along the motion, ``width``
+    across it and ``height``.
+
     Attributes
     ----------
     shape : str
         One of :data:`KNOWN_SHAPES`.
-    radius : float
-        Tank radius [m].
+    radius : float or None
+        Tank radius [m] (sphere, cylinder, capsule); None for a rectangular tank.
     fill_fraction : float
         Liquid depth / tank height, in (0, 1) [-].
     diaphragm : bool
         Whether the tank has an elastomeric diaphragm.
+    length : float or None
+        Cylinder: inside height [m]; rectangular tank: inside length along the motion [m].
+    cylinder_length : float or None
+        Capsule: length of the cylindrical section between the domes [m] (>= 0).
+    width, height : float or None
+        Rectangular tank: inside width across the motion and inside height [m].
     """
 
     shape: str
-    radius: float
+    radius: float | None
     fill_fraction: float
     diaphragm: bool
+    length: float | None = None
+    cylinder_length: float | None = None
+    width: float | None = None
+    height: float | None = None
+
+    def geometry(self):
+        """The tank as an :mod:`analogs.tank` geometry (:class:`~analogs.tank.Sphere`,
+        :class:`~analogs.tank.Cylinder`, :class:`~analogs.tank.Capsule` or
+        :class:`~analogs.tank.Rectangular`): volumes, liquid mass and the modal prediction
+        all come from it."""
+        from analogs.tank import Capsule, Cylinder, Rectangular, Sphere
+
+        if self.shape == "sphere":
+            return Sphere(self.radius)
+        if self.shape == "cylinder":
+            return Cylinder(self.radius, self.length)
+        if self.shape == "capsule":
+            return Capsule(self.radius, self.cylinder_length)
+        return Rectangular(self.length, self.width, self.height)
+
+    def liquid_mass(self, density: float) -> float:
+        """Mass of the liquid [kg] of ``density`` [kg/m^3] at :attr:`fill_fraction`."""
+        return self.geometry().liquid_mass(self.fill_fraction, density)
+
+    @property
+    def size_text(self) -> str:
+        """The tank's size as reports print it (``"sphere R = 0.1016 m"``,
+        ``"rectangular 0.4 x 0.2 x 0.3 m"``)."""
+        if self.shape == "rectangular":
+            return f"rectangular {self.length:g} x {self.width:g} x {self.height:g} m"
+        extra = (f", length {self.length:g} m" if self.shape == "cylinder" else
+                 f", cylinder length {self.cylinder_length:g} m" if self.shape == "capsule"
+                 else "")
+        return f"{self.shape} R = {self.radius:g} m{extra}"
+
+
+#: Size keys of ``[tank]`` by shape (m), besides ``fill_fraction`` and ``diaphragm``.
+SHAPE_KEYS: dict[str, tuple[str, ...]] = {
+    "sphere": ("radius",), "cylinder": ("radius", "length"),
+    "capsule": ("radius", "cylinder_length"), "rectangular": ("length", "width", "height")}
 
 
 @dataclass(frozen=True)
@@ -495,6 +575,9 @@ class Case:
     columns : mapping of str to numpy.ndarray
         The CSV columns besides ``time`` of a spinning-rig case (empty for a lateral case);
         read them through :attr:`channels`.
+    notes : tuple of str
+        What loading did to the record (e.g. the new time base of ``[test] resample_hz``);
+        fit reports print them.
     """
 
     path: Path
@@ -508,6 +591,7 @@ class Case:
     displacement: NDArray[np.float64] | None = field(repr=False)
     force: NDArray[np.float64] | None = field(repr=False)
     columns: Mapping[str, NDArray[np.float64]] = field(default_factory=dict, repr=False)
+    notes: tuple[str, ...] = ()
 
     @property
     def channels(self) -> dict[str, NDArray[np.float64]]:

@@ -107,7 +107,8 @@ def experiment(case: Case, model: Model) -> Experiment:
             raise InputError(f"{case.path}: excitation = 'measured' needs a displacement column")
 
         def exc() -> Excitation | None:
-            x, xd, xdd = displacement_derivatives(case.time, case.displacement)
+            x, xd, xdd = displacement_derivatives(case.time, case.displacement,
+                                                  motion_band_hz=case.test.motion_band_hz)
             return Sampled(case.time, np.vstack([x, xd, xdd]))
     elif case.spin is not None and case.spin.motion == "input":
         from .spin import spin_excitation

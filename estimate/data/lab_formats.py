@@ -342,10 +342,12 @@ def _open(path: Path, fmt: str, stack) -> tuple[dict[str, _Channel], list[str]]:
 
 
 def read_lab(path: Path, toml_name: str, doc: Mapping[str, Any], excitation: str | None,
-             rig_kind: str | None, rig: Rig | None, problems: list[str]) -> tuple[Any, ...] | None:
+             rig_kind: str | None, rig: Rig | None, problems: list[str], *,
+             uniform: bool = True) -> tuple[Any, ...] | None:
     """Read the channels ``[data.columns]`` of the case document ``doc`` names from the lab
     file ``path``; append problems; return ``(time, displacement, force, columns)`` as
-    :func:`estimate.data._csv.read_csv` does, or None."""
+    :func:`estimate.data._csv.read_csv` does, or None (``uniform=False``: the time need not
+    be uniform, ``[test] resample_hz``)."""
     import contextlib
 
     name = path.name
@@ -378,7 +380,7 @@ def read_lab(path: Path, toml_name: str, doc: Mapping[str, Any], excitation: str
             return None
         try:
             out = _read_channels(name, fmt, wanted, channels, listing, rig_kind, rig, problems,
-                                 n_before)
+                                 n_before, uniform)
         except Exception as exc:  # noqa: BLE001 - a library failing inside a damaged file
             del problems[n_before:]
             problems.append(f"{name}: not a readable {fmt} file (damaged: reading its channels "
@@ -403,7 +405,8 @@ def _mat5_damage(path: Path) -> str | None:
 
 def _read_channels(name: str, fmt: str, wanted: dict[str, _Spec], channels: dict[str, _Channel],
                    listing: list[str], rig_kind: str | None, rig: Rig | None,
-                   problems: list[str], n_before: int) -> tuple[Any, ...] | None:
+                   problems: list[str], n_before: int, uniform: bool = True
+                   ) -> tuple[Any, ...] | None:
     def key(spec: _Spec) -> str:
         return (f"[data.columns] {spec.column}" if spec.explicit else
                 f"column `{spec.column}`, looked up by name without [data.columns]")
@@ -484,7 +487,7 @@ def _read_channels(name: str, fmt: str, wanted: dict[str, _Spec], channels: dict
     data = np.column_stack([values[c] for c in order])
     check_samples(name, [labels[c] for c in order], data, problems, row=lambda i: i,
                   where=lambda rows: rows_text(rows, "index", "indices"), kind="channel",
-                  quantities=order)
+                  quantities=order, uniform=uniform)
     if len(problems) > n_before:
         return None
     time = values["time"]

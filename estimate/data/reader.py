@@ -98,6 +98,7 @@ def load_case(path: str | os.PathLike[str], *, strict: bool = False) -> Case:
     t_table = doc.get("test")
 
     problems = ck.problems
+    notes: list[str] = []
     arrays = None
     data_path: Path | None = None
     data_name = t_table.get("data") if isinstance(t_table, Mapping) else None
@@ -120,11 +121,16 @@ def load_case(path: str | os.PathLike[str], *, strict: bool = False) -> Case:
                             "header (`time,displacement,force`, SI units)")
         else:
             csv_problems: list[str] = []
+            uniform = not (isinstance(t_table, Mapping) and "resample_hz" in t_table)
             if lab:
-                arrays = read_lab(data_path, fname, doc, excitation, rig_kind, rig, csv_problems)
+                arrays = read_lab(data_path, fname, doc, excitation, rig_kind, rig, csv_problems,
+                                  uniform=uniform)
             else:
-                arrays = read_csv(data_path, excitation, csv_problems, rig_kind)
+                arrays = read_csv(data_path, excitation, csv_problems, rig_kind, uniform=uniform)
             problems.extend(csv_problems)
+            if arrays is not None and test is not None and test.resample_hz is not None:
+                arrays, note = _uniform(data_path.name, arrays, test.resample_hz, problems)
+                notes.append(note)
             if arrays is not None and rig is not None:
                 from .spin import spin_column_problems
 
@@ -146,6 +152,24 @@ def load_case(path: str | os.PathLike[str], *, strict: bool = False) -> Case:
             arr.flags.writeable = False
     return Case(path=toml_path.resolve(), data_path=data_path.resolve(), test=test, tank=tank,
                 liquid=liquid, rig=rig, prediction=prediction, time=time, displacement=disp,
-                force=force, columns=columns)
+                force=force, columns=columns, notes=tuple(n for n in notes if n))
+
+
+def _uniform(name: str, arrays: tuple, rate_hz: float, problems: list[str]
+             ) -> tuple[tuple | None, str]:
+    """``arrays`` (time, displacement, force, columns) on a uniform time base at about
+    ``rate_hz`` (:func:`estimate.data.timebase.uniform_record`), and what was done."""
+    from .budget import max_samples
+    from .timebase import uniform_record
+
+    time, disp, force, columns = arrays
+    named = {"displacement": disp, "force": force, **columns}
+    record = uniform_record(name, time, {k: v for k, v in named.items() if v is not None},
+                            rate_hz, problems, max_samples=max_samples())
+    if record is None:
+        return None, ""
+    out = record.columns
+    return ((record.time, out.get("displacement"), out.get("force"),
+             {k: out[k] for k in columns}), record.note)
 
 

@@ -15,7 +15,8 @@ from typing import Any
 import numpy as np
 from numpy.typing import ArrayLike, NDArray
 
-from .case import LIMIT_UNITS, SPINNING_CHANNELS, Case, Liquid, Prediction, Rig, Tank, TestInfo
+from .case import (LIMIT_UNITS, SHAPE_KEYS, SPINNING_CHANNELS, Case, Liquid, Prediction, Rig,
+                   Tank, TestInfo)
 from .reader import load_case
 
 __all__ = ["write_case"]
@@ -62,10 +63,18 @@ def _toml_text(test: TestInfo, tank: Tank, liquid: Liquid, rig: Rig,
         rows.append(("starts_at_rest", test.starts_at_rest, "tank and carriage at rest at t[0]"))
     if test.initial_state is not None:
         rows.append(("initial_state", test.initial_state, "the liquid at t[0]"))
+    if test.resample_hz is not None:
+        rows.append(("resample_hz", test.resample_hz, "Hz, a uniform time base for the record"))
+    if test.motion_band_hz is not None:
+        rows.append(("motion_band_hz", test.motion_band_hz, "Hz, top of the carriage motion"))
     table("test", rows)
-    table("tank", [("shape", tank.shape, ""), ("radius", tank.radius, "m"),
-                   ("fill_fraction", tank.fill_fraction, "liquid depth / tank height"),
-                   ("diaphragm", tank.diaphragm, "")])
+    sizes = {"radius": "m", "length": "m, cylinder height or rectangular along the motion",
+             "cylinder_length": "m, capsule straight section", "width": "m, across the motion",
+             "height": "m, inside height"}
+    table("tank", [("shape", tank.shape, "")]
+          + [(k, getattr(tank, k), note) for k, note in sizes.items() if k in SHAPE_KEYS[tank.shape]]
+          + [("fill_fraction", tank.fill_fraction, "liquid depth / tank height"),
+             ("diaphragm", tank.diaphragm, "")])
     table("liquid", [("density", liquid.density, "kg/m^3"),
                      ("kinematic_viscosity", liquid.kinematic_viscosity, "m^2/s")])
     table("rig", [("dry_mass", rig.dry_mass, "kg moving with the tank, seen by the transducer"),

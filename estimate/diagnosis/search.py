@@ -198,7 +198,7 @@ def force_cutoff(cases: Sequence[Case]) -> float:
         if c.spin is not None:
             top = abs(c.spin.rate) / (2 * math.pi)
         elif c.displacement is not None:
-            top = max(significant_frequencies(c.time, c.displacement))
+            top = max(significant_frequencies(c.time, c.displacement), default=0.0)
         else:
             top = c.crank.frequency if c.crank is not None else 2.5
         tops.append(min(max(10.0, 4.0 * top), 0.4 * fs))

@@ -10,9 +10,16 @@ measured displacement (weighted by the displacement noise) and the measured forc
 measurements support together.
 
 The knots are uniform, spaced ``1 / (12 f_top)`` with ``f_top`` the highest significant
-frequency of the carriage motion (at least one sample, at most 50 ms): a quintic spline
-then represents the carriage acceleration to ~2e-4 of its amplitude. Both noise levels are
-estimated from the spectra above the signal band (:func:`estimate.data.signals.noise_level`);
+frequency of the carriage motion (:func:`estimate.data.signals.motion_band`, or the case's
+``[test] motion_band_hz``; at least one sample, at most 50 ms - also the spacing of a
+carriage at rest, whose displacement holds nothing above its noise): a quintic spline then
+represents the carriage acceleration to ~2e-4 of its amplitude. The noise band starts
+above the carriage motion's frequencies, or, when the carriage stands still, above the
+force's own (a free decay's force rings at the slosh frequency). Both
+noise levels are estimated from the spectra above the signal band
+(:func:`estimate.data.signals.noise_level`; the displacement's from the start spline's
+misfit instead when that is clearly larger: noise that is not white, as a displacement
+integrated from an accelerometer has, :data:`COLOURED_FACTOR`);
 a record that starts quiet starts with the carriage at rest (zero velocity and
 acceleration at the first sample).
 """
@@ -29,7 +36,13 @@ from scipy.interpolate import BSpline
 
 from derive import Excitation
 
-from ..data.signals import noise_level, remove_tones, significant_frequencies, starts_quiet
+from ..data.signals import (
+    motion_band,
+    noise_level,
+    remove_tones,
+    significant_frequencies,
+    starts_quiet,
+)
 
 __all__ = ["CarriageSpline", "CarriageInput", "SplineExcitation", "RecordNoise",
            "carriage_input", "record_noise"]
@@ -45,6 +58,11 @@ NOISE_BAND_MIN_HZ = 12.0
 #: Noise levels are floored at this fraction of the signal's RMS: a noiseless synthetic
 #: record must not get an infinite weight.
 NOISE_FLOOR = 1e-6
+#: The displacement noise is taken from the start spline's misfit when that exceeds the
+#: white level above the band by this factor (white noise: the two agree within a few per
+#: cent; a displacement integrated from an accelerometer: its red noise between the
+#: spline's resolution and the band, 10-100 times the level above the band).
+COLOURED_FACTOR = 1.5
 
 
 @dataclass(frozen=True)
@@ -121,6 +139,12 @@ class CarriageInput:
         The tones removed: frequency (Hz) and amplitude (m).
     at_rest : bool
         The record starts quiet: the carriage velocity and acceleration are 0 at ``t[0]``.
+    coloured_noise : bool
+        The displacement's noise is not white: the least-squares spline misses the record
+        by more than :data:`COLOURED_FACTOR` times the white level above the band (a
+        displacement integrated from an accelerometer: its noise grows towards low
+        frequencies), so ``displacement_noise`` is that misfit's standard deviation
+        (``n - coefficients`` degrees of freedom).
     """
 
     spline: CarriageSpline
@@ -130,6 +154,7 @@ class CarriageInput:
     displacement: np.ndarray = field(repr=False)
     displacement_tones: tuple[tuple[float, float], ...]
     at_rest: bool
+    coloured_noise: bool = False
     _memo: dict = field(default_factory=dict, compare=False, repr=False)
 
     @property
@@ -245,10 +270,13 @@ def record_noise(time: np.ndarray, force: np.ndarray, top_frequency: float) -> R
 
 def carriage_input(time: np.ndarray, displacement: np.ndarray, *,
                    at_rest: bool | None = None,
-                   force: np.ndarray | None = None) -> tuple[CarriageInput, RecordNoise]:
+                   force: np.ndarray | None = None,
+                   motion_band_hz: float | None = None) -> tuple[CarriageInput, RecordNoise]:
     """Spline, start values and noise levels for estimating the carriage motion of a record
     (``time`` s, ``displacement`` m, ``force`` N), and the force's noise. ``at_rest=None``
-    detects a quiet start (:func:`estimate.data.signals.starts_quiet` on both channels).
+    detects a quiet start (:func:`estimate.data.signals.starts_quiet` on both channels);
+    ``motion_band_hz`` (Hz) is the carriage motion's highest frequency, which sets the knot
+    spacing (default: :func:`estimate.data.signals.motion_band` of the displacement).
 
     The last few records' results are kept (keyed by the samples' bytes): the diagnosis
     builds a problem per candidate model of the same record. The returned objects are
@@ -256,9 +284,10 @@ def carriage_input(time: np.ndarray, displacement: np.ndarray, *,
     arrays = [None if a is None else np.ascontiguousarray(a, float)
               for a in (time, displacement, force)]
     key = (hashlib.sha256(b"".join(b"" if a is None else a.tobytes() for a in arrays)).hexdigest(),
-           tuple(-1 if a is None else a.size for a in arrays), at_rest)
+           tuple(-1 if a is None else a.size for a in arrays), at_rest, motion_band_hz)
     if key not in _RECENT:
-        _RECENT[key] = _carriage_input(arrays[0], arrays[1], arrays[2], at_rest=at_rest)
+        _RECENT[key] = _carriage_input(arrays[0], arrays[1], arrays[2], at_rest=at_rest,
+                                       motion_band_hz=motion_band_hz)
         while len(_RECENT) > _RECENT_SIZE:
             _RECENT.pop(next(iter(_RECENT)))
     return _RECENT[key]
@@ -275,12 +304,19 @@ def forget_records() -> None:
 
 
 def _carriage_input(time: np.ndarray, displacement: np.ndarray, force: np.ndarray, *,
-                    at_rest: bool | None) -> tuple[CarriageInput, RecordNoise]:
+                    at_rest: bool | None, motion_band_hz: float | None = None
+                    ) -> tuple[CarriageInput, RecordNoise]:
     t = np.asarray(time, float)
     x = np.asarray(displacement, float)
     dt = float(np.median(np.diff(t)))
-    f_top = max(significant_frequencies(t, x))
-    spacing = min(max(1.0 / (KNOTS_PER_PERIOD * f_top), dt), MAX_SPACING)
+    f_motion = motion_band_hz or motion_band(t, x)
+    spacing = MAX_SPACING if f_motion is None else \
+        min(max(1.0 / (KNOTS_PER_PERIOD * f_motion), dt), MAX_SPACING)
+    if f_motion is None:  # a carriage at rest: the force's own mechanics (a free decay's)
+        f_top = max(significant_frequencies(t, np.asarray(force, float), derivative=0),
+                    default=0.0)
+    else:
+        f_top = f_motion
     noise = record_noise(t, force, f_top)
     x_clean, x_tones = remove_tones(t, x, above_hz=noise.band_hz)
     sx = max(noise_level(t, x_clean, above_hz=noise.band_hz), NOISE_FLOOR * float(np.std(x)))
@@ -289,9 +325,28 @@ def _carriage_input(time: np.ndarray, displacement: np.ndarray, force: np.ndarra
     spline = CarriageSpline.covering(float(t[0]), float(t[-1]), spacing)
     basis = _rest_basis(spline, float(t[0])) if at_rest else None
     B = spline.design(t) if basis is None else (spline.design(t) @ basis).tocsr()
-    ci = CarriageInput(spline, basis, _least_squares(B, x_clean), sx, x_clean, x_tones,
-                       bool(at_rest))
+    coefficients = _least_squares(B, x_clean)
+    s_fit = _misfit(B, coefficients, x_clean)
+    coloured = s_fit > COLOURED_FACTOR * sx
+    if coloured:
+        # a drifting displacement leaks into the tone fit (offset and trend only): look
+        # for tones in what the spline does not follow, then fit the spline again
+        smooth = B @ _least_squares(B, x)
+        rest, x_tones = remove_tones(t, x - smooth, above_hz=noise.band_hz)
+        x_clean = smooth + rest
+        coefficients = _least_squares(B, x_clean)
+        s_fit = _misfit(B, coefficients, x_clean)
+        coloured = s_fit > COLOURED_FACTOR * sx
+    ci = CarriageInput(spline, basis, coefficients, s_fit if coloured else sx, x_clean, x_tones,
+                       bool(at_rest), coloured_noise=coloured)
     return ci, noise
+
+
+def _misfit(B: sps.spmatrix, coefficients: np.ndarray, x: np.ndarray) -> float:
+    """Standard deviation of what the spline (design ``B``) misses of ``x`` (its degrees of
+    freedom: samples less coefficients)."""
+    r = x - B @ coefficients
+    return float(np.sqrt(r @ r / max(x.size - B.shape[1], 1)))
 
 
 def _least_squares(B: sps.spmatrix, x: np.ndarray) -> np.ndarray:

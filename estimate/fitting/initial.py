@@ -23,19 +23,19 @@ LENGTH_BAND = 0.20
 PREDICTION_FACTOR = 3.0
 
 
-def tank_prediction(shape: str, radius: float, fill: float, *, density: float,
-                    viscosity: float, gravity: float, modes: int = 1, method: str = "exact",
-                    diaphragm: bool = False):
-    """The tank modal analysis (:func:`analogs.tank.predict`) of a case file's tank: a
-    sphere, or a cylinder as tall as its diameter; radius in m, fill as liquid depth / tank
-    height, density in kg/m^3, kinematic viscosity in m^2/s, gravity in m/s^2. The modal
-    analysis is kept on disk (:mod:`estimate.fitting._tank_cache`): a tank and fill seen
-    before costs no solve."""
-    from analogs.tank import METHODS, Cylinder, Liquid, Sphere, predict
+def tank_prediction(tank, fill: float, *, density: float, viscosity: float, gravity: float,
+                    modes: int = 1, method: str = "exact", diaphragm: bool = False):
+    """The tank modal analysis (:func:`analogs.tank.predict`) of a case file's tank.
+
+    ``tank`` is an :mod:`analogs.tank` geometry (a case file's ``[tank]`` gives it:
+    :meth:`estimate.data.case.Tank.geometry`); fill as liquid depth / tank height, density
+    in kg/m^3, kinematic viscosity in m^2/s, gravity in m/s^2. The modal analysis is kept
+    on disk (:mod:`estimate.fitting._tank_cache`): a tank and fill seen before costs no
+    solve (a rectangular tank's modes are in closed form)."""
+    from analogs.tank import METHODS, Liquid, predict
 
     from ._tank_cache import CachedSolver
 
-    tank = Sphere(radius) if shape == "sphere" else Cylinder(radius, 2 * radius)
     if method not in METHODS:
         raise InputError(f"tank modal analysis method must be one of {', '.join(METHODS)}, "
                          f"got {method!r}")
@@ -45,7 +45,7 @@ def tank_prediction(shape: str, radius: float, fill: float, *, density: float,
 
 
 def _tank_prediction(case: Case, modes: int):
-    return tank_prediction(case.tank.shape, case.tank.radius, case.tank.fill_fraction,
+    return tank_prediction(case.tank.geometry(), case.tank.fill_fraction,
                            density=case.liquid.density,
                            viscosity=case.liquid.kinematic_viscosity, gravity=case.rig.gravity,
                            modes=modes, diaphragm=case.tank.diaphragm)
@@ -68,8 +68,8 @@ def prediction_conflicts(case: Case, *, factor: float = PREDICTION_FACTOR) -> li
         ratio = given / modal if modal > 0 else math.inf
         if not 1 / factor <= ratio <= factor:
             out.append(f"{case.path.name}: [prediction] {key} = {given:.4g} {unit} contradicts "
-                       f"the modal prediction {modal:.4g} {unit} of the tank ({t.shape}, radius "
-                       f"{t.radius:g} m, fill {t.fill_fraction:g}) by a factor {ratio:.3g} (more "
+                       f"the modal prediction {modal:.4g} {unit} of the tank ({t.size_text}, "
+                       f"fill {t.fill_fraction:g}) by a factor {ratio:.3g} (more "
                        f"than {factor:g}): check [tank] and [prediction]; the fit starts from "
                        "[prediction]")
     return out
@@ -122,7 +122,7 @@ def predicted_sources(case: Case, model: Model, needed: Iterable[str] | None = N
             analysis, failure = None, f"the tank modal analysis failed: {err}"
         if analysis is not None:
             tank = case.tank
-            label = (f"the tank modal analysis ({tank.shape} R = {tank.radius:g} m, "
+            label = (f"the tank modal analysis ({tank.size_text}, "
                      f"{100 * tank.fill_fraction:g} % fill)")
             for i, mode in enumerate(analysis.modes):
                 name = f"p{i + 1}"
@@ -164,8 +164,8 @@ def _guesses(case: Case, model: Model, out: dict[str, float], source: dict[str, 
     """Starting values nothing predicts: rotors, rotary oscillators, 3-DOF bob inertias."""
     from analogs import RotaryOscillator, Rotor, ThreeDofPendulum
 
-    R = case.tank.radius
-    liquid = case.liquid.density * 4 / 3 * math.pi * R**3 * case.tank.fill_fraction
+    R = case.tank.geometry().radius  # a rectangular tank: half its length along the motion
+    liquid = case.tank.liquid_mass(case.liquid.density)
     spin = abs(case.spin.rate) if case.spin is not None else 0.0
     for comp in model.components:
         n = comp.name

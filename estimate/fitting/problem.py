@@ -17,6 +17,7 @@ from ..data.experiment import Experiment, experiment
 from ..data.models import model_for_case
 from ..data.records import refuse_repeated
 from .carriage import CarriageInput, RecordNoise, carriage_input, record_noise
+from .free_decay import rest_holds
 from .initial import length_bounds, nominal_scale, predicted_sources, source_notes
 
 __all__ = ["FitProblem", "Estimated", "PER_CASE", "INPUT_MODES"]
@@ -167,9 +168,13 @@ class FitProblem:
                            + ", ".join(params))
         rig_fixed = set().union(*(e.fixed for e in exps))
         needed = list(dict.fromkeys(n for e in exps for n in e.derived.needed_parameters()))
+        notes = [n for c in cases for n in c.notes]  # what loading did to the records
         if estimate is None:
             names = [n for n in needed if n not in rig_fixed and n not in hold]
             names += [n for mm in measurement for n in mm.parameters if n not in hold]
+            at_rest, rest_notes = rest_holds(exps, names)  # free decays: masses undetermined
+            names = [n for n in names if n not in at_rest]
+            notes += rest_notes
         else:
             names = list(estimate)
             clash = sorted(set(names) & set(hold))
@@ -177,7 +182,6 @@ class FitProblem:
                 raise InputError(f"parameters both estimated and held: {', '.join(clash)}")
         predicted, sources, failure = predicted_sources(cases[0], model, names)
         explicit = model.explicit_values()
-        notes = []
         start: dict[str, float] = {}
         for n in params:
             # user's initial value > value given to a constructor > prediction > declared default
@@ -375,7 +379,8 @@ def _input_estimation(exps: Sequence[Experiment], mode: str, cutoff: float | Non
             noise.append(None)
         elif case.test.excitation == "measured":
             ci, rn = carriage_input(case.time, case.displacement, force=case.force,
-                                    at_rest=case.test.starts_at_rest)
+                                    at_rest=case.test.starts_at_rest,
+                                    motion_band_hz=case.test.motion_band_hz)
             carriage.append(ci)
             noise.append(rn)
         else:  # crank: the motion is a parametric model; the force's noise weighs it
@@ -396,7 +401,10 @@ def _noise_notes(exps, carriage, noise) -> tuple[str, ...]:
         if ci is not None:
             text += (f"; carriage motion estimated (quintic spline, knots "
                      f"{1e3 * ci.spline.spacing:.3g} ms apart"
-                     + (", at rest at the first sample)" if ci.at_rest else ")"))
+                     + (", at rest at the first sample)" if ci.at_rest else ")")
+                     + ("; the displacement noise is not white (a drifting or integrated "
+                        "displacement): its level is the start spline's misfit"
+                        if ci.coloured_noise else ""))
         notes.append(text)
         for label, tones, unit in (("force", rn.tones, "N"),
                                    ("displacement", ci.displacement_tones if ci else (), "m")):

@@ -332,6 +332,7 @@ class FitResult:
             "warnings": list(self.warnings),
             "input": self.problem.input,
             "covariance_note": self.covariance_note(),
+            "notes": list(self.problem.notes),
             "residual_variance": self.residual_variance,
             "noise": [_noise_dict(ci, rn) for ci, rn in zip(
                 self.problem.carriage or [None] * len(self.problem.experiments),

@@ -27,7 +27,7 @@ end model does not hold (e.g. a 30 Hz tone) leaks partly into the end fit; the f
 samples then carry an error of order 10% of that component's amplitude.
 """
 
-from .derivatives import displacement_derivatives, significant_frequencies
+from .derivatives import displacement_derivatives, motion_band, significant_frequencies
 from .filters import lowpass
 from .noise import noise_level, remove_tones, starts_quiet
 from .spectra import (
@@ -53,6 +53,7 @@ __all__ = [
     "lowpass",
     "noise_level",
     "remove_tones",
+    "motion_band",
     "significant_frequencies",
     "starts_quiet",
     "welch_spectrum",

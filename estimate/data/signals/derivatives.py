@@ -22,34 +22,61 @@ from ._common import (
 from .filters import _extend, _pad_seconds
 from .spectra import find_spectral_peaks, welch_spectrum
 
-__all__ = ["displacement_derivatives", "significant_frequencies"]
+__all__ = ["displacement_derivatives", "motion_band", "significant_frequencies"]
 
 
-def significant_frequencies(t: NDArray[np.float64], x: NDArray[np.float64]) -> list[float]:
-    """Frequencies of displacement components whose *acceleration* is >= 1% of the largest.
+def significant_frequencies(t: NDArray[np.float64], x: NDArray[np.float64], *,
+                            derivative: int = 2) -> list[float]:
+    """Frequencies [Hz] of the components of ``x`` whose ``derivative``-th time derivative
+    (default 2: the acceleration of a displacement) is >= 1% of the largest; empty when
+    ``x`` holds nothing above its noise (a carriage at rest).
 
-    Spectral peaks cover sines and cranks; for broadband drives (sweeps, steps) the upper
-    edge of the band where the displacement stands 20 dB above the noise floor and its
-    acceleration power is at least 1e-4 of the strongest is added, so a sweep's top
-    frequency is never filtered away.
+    Spectral peaks cover sines and cranks; for broadband content (sweeps, steps, transport
+    moves, drifts) the upper edge of the band where ``x`` stands 20 dB above the noise
+    floor and the derivative's power is at least 1e-4 of the strongest is added, so a
+    sweep's top frequency is never filtered away. A peak counts only when it stands 20 dB
+    above the noise floor (the median PSD): the strongest bin of pure noise is not a
+    frequency of the motion.
     """
-    peaks = find_spectral_peaks(t, x, min_frequency=2.0 / (t[-1] - t[0]),
-                                min_relative_height=1e-8, max_peaks=12, refine=False)
-    if not peaks:
-        raise InputError("no spectral peak found in the displacement; cannot choose a filter "
-                         "cutoff: pass `cutoff_hz` (butterworth) or `window` (savgol)")
-    # Noise makes peaks too, and weighting by (2 pi f)^2 favours high-frequency noise: keep
-    # only peaks 20 dB above the noise floor (median PSD: the spectrum is mostly floor).
     spec = welch_spectrum(t, x)
     floor = float(np.median(spec.psd))
-    peaks = tuple(p for p in peaks if p.psd >= _FLOOR_RATIO * floor) or peaks[:1]
-    acc = np.array([(2 * np.pi * p.frequency) ** 2 * p.amplitude for p in peaks])
-    freqs = [p.frequency for p, a in zip(peaks, acc) if a >= _SIGNIFICANT * acc.max()]
-    acc_psd = (2 * np.pi * spec.frequency) ** 4 * spec.psd
-    band = (spec.psd >= _FLOOR_RATIO * floor) & (acc_psd >= _SIGNIFICANT**2 * acc_psd.max())
+    peaks = find_spectral_peaks(t, x, min_frequency=2.0 / (t[-1] - t[0]),
+                                min_relative_height=1e-8, max_peaks=12, refine=False)
+    # Noise makes peaks too, and weighting by (2 pi f)^2 favours high-frequency noise: keep
+    # only peaks 20 dB above the noise floor (median PSD: the spectrum is mostly floor).
+    peaks = tuple(p for p in peaks if p.psd >= _FLOOR_RATIO * floor)
+    power = (2 * np.pi * spec.frequency) ** (2 * derivative) * spec.psd
+    freqs = []
+    if peaks:
+        amp = np.array([(2 * np.pi * p.frequency) ** derivative * p.amplitude for p in peaks])
+        freqs = [p.frequency for p, a in zip(peaks, amp) if a >= _SIGNIFICANT * amp.max()]
+    band = (spec.psd >= _FLOOR_RATIO * floor) & (power >= _SIGNIFICANT**2 * power.max())
+    band[0] = False  # the mean is not a frequency of the motion
     if np.any(band):
         freqs.append(float(spec.frequency[np.flatnonzero(band)[-1]]))
     return freqs
+
+
+def motion_band(time: ArrayLike, displacement: ArrayLike) -> float | None:
+    """Highest significant frequency of a carriage motion [Hz] (the top of
+    :func:`significant_frequencies` of the displacement: its acceleration decides), or
+    ``None`` when the displacement holds nothing above its noise (the carriage at rest, a
+    free decay). It sets the displacement filter's cutoff (:func:`displacement_derivatives`)
+    and the estimated carriage spline's knot spacing; a case file's ``[test]
+    motion_band_hz`` (``slosh fit --motion-band``) gives it when the record cannot.
+
+    Examples
+    --------
+    >>> import numpy as np
+    >>> t = np.arange(3001) * 0.01
+    >>> round(motion_band(t, 0.005 * np.sin(2 * np.pi * 1.855 * t)), 2)
+    1.86
+    >>> motion_band(t, np.random.default_rng(0).normal(0, 2e-5, t.size)) is None
+    True
+    """
+    t, x, _ = _as_uniform(time, displacement, "displacement")
+    freqs = significant_frequencies(t, x)
+    return max(freqs) if freqs else None
 
 
 def _savgol_window(freqs: list[float], step: float, polyorder: int, n: int) -> int:
@@ -76,7 +103,7 @@ def displacement_derivatives(
     time: ArrayLike, displacement: ArrayLike, *,
     method: Literal["butterworth", "savgol"] = "butterworth",
     cutoff_hz: float | None = None, order: int = _DERIV_ORDER,
-    window: int | None = None, polyorder: int = 8,
+    window: int | None = None, polyorder: int = 8, motion_band_hz: float | None = None,
 ) -> tuple[NDArray[np.float64], NDArray[np.float64], NDArray[np.float64]]:
     """Smoothed carriage displacement, velocity and acceleration, without phase lag.
 
@@ -100,7 +127,8 @@ def displacement_derivatives(
         ``deriv`` 0, 1, 2).
     cutoff_hz : float, optional
         Butterworth cutoff [Hz]. Default: ``max(4 Hz, 1.6 f_max)``, with ``f_max`` the highest
-        significant component, capped at 0.4 times the sampling rate.
+        significant component (:func:`motion_band`; 0 for a carriage at rest), capped at 0.4
+        times the sampling rate.
     order : int, default 8
         Butterworth order of one pass (steep, so the cutoff can sit close to the signal).
     window : int, optional
@@ -109,6 +137,9 @@ def displacement_derivatives(
     polyorder : int, default 8
         Savitzky-Golay polynomial order (8 allows windows about 4 times longer than 4 at
         the same gain error, hence less noise).
+    motion_band_hz : float, optional
+        The carriage motion's highest frequency [Hz] (a case's ``[test] motion_band_hz``),
+        used for ``f_max`` instead of reading it from the record.
 
     Returns
     -------
@@ -133,8 +164,8 @@ def displacement_derivatives(
     t, x, step = _as_uniform(time, displacement, "displacement")
     fs = 1.0 / step
     if method == "butterworth":
-        if cutoff_hz is None:
-            f_max = max(significant_frequencies(t, x))
+        if cutoff_hz is None:  # a carriage at rest: any cutoff keeps its (constant) position
+            f_max = motion_band_hz or motion_band(t, x) or 0.0
             cutoff_hz = min(max(_AUTO_CUTOFF_MIN_HZ, _AUTO_CUTOFF_FACTOR * f_max), 0.4 * fs)
         if not 0.0 < cutoff_hz < 0.5 * fs:
             raise InputError(f"expected 0 < `cutoff_hz` < Nyquist frequency {0.5 * fs:g} Hz, "
@@ -151,7 +182,8 @@ def displacement_derivatives(
         return xs[sl].copy(), xd, xdd
     if method == "savgol":
         if window is None:
-            window = _savgol_window(significant_frequencies(t, x), step, polyorder, t.size)
+            freqs = [motion_band_hz] if motion_band_hz else significant_frequencies(t, x)
+            window = _savgol_window(freqs or [_AUTO_CUTOFF_MIN_HZ], step, polyorder, t.size)
         if window % 2 == 0 or window <= polyorder or window > t.size:
             raise InputError(f"expected an odd `window` > polyorder ({polyorder}) and <= "
                              f"{t.size} samples, found {window!r}")

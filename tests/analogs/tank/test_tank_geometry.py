@@ -69,7 +69,7 @@ def test_bad_profile_lists_every_problem():
 
 
 def test_unknown_shape_method_and_liquid_are_rejected():
-    with pytest.raises(ValueError, match="`tank` must be a Sphere, Cylinder, Capsule or Profile"):
+    with pytest.raises(ValueError, match="`tank` must be a Sphere, Cylinder, Capsule, Profile or Rect"):
         predict("cube", fill=0.5)
     with pytest.raises(ValueError, match="`method` must be one of"):
         predict(Sphere(0.1), fill=0.5, method="magic")

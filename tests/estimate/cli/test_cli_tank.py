@@ -54,9 +54,16 @@ def test_cli_volume_fill_legacy_and_plot(tmp_path):
 
 def test_cli_bad_input_exits_2_with_message(capsys):
     assert main(["tank", "--shape", "cylinder", "--radius", "0.1", "--fill", "0.5"]) == 2
-    assert "`--length` (m) is required" in capsys.readouterr().err
+    assert "--shape cylinder takes `--radius`, `--length` (m); got none for `--length`" \
+        in capsys.readouterr().err
+    assert main(["tank", "--shape", "sphere", "--radius", "0.1", "--width", "0.2",
+                 "--fill", "0.5"]) == 2
+    assert "`--width` does not apply" in capsys.readouterr().err
     assert main(["tank", "--radius", "-1", "--fill", "0.5"]) == 2
-    assert "`radius` must be a positive number" in capsys.readouterr().err
+    assert "--radius -1: expected 1e-06 to 1000 m" in capsys.readouterr().err
+    assert main(["tank", "--shape", "rectangular", "--length", "0.3", "--width", "1e300",
+                 "--height", "0.2", "--fill", "0.5"]) == 2
+    assert "--width 1e+300: expected 1e-06 to 1000 m" in capsys.readouterr().err
     with pytest.raises(SystemExit):
         parse(["tank", "--shape", "cube", "--radius", "1", "--fill", "0.5"])
 
@@ -70,3 +77,20 @@ def test_analog_model_uses_prediction():
     c = 2 * m.damping_ratio * m.mass * m.length**2 * 2 * math.pi * m.frequency_hz
     got = float(text.split("HingeDamper('p1', damping=")[1].split(")")[0])
     assert got == pytest.approx(c, rel=1e-12)  # round-off of omega only
+
+
+def test_rectangular_tank_in_closed_form(tmp_path, capsys):
+    """SP-106 / Ibrahim: ``omega^2 = (pi g / a) tanh(pi h / a)`` for a box of length a along
+    the motion filled to depth h."""
+    import json
+
+    out = tmp_path / "box.json"
+    assert main(["tank", "--shape", "rectangular", "--length", "0.4", "--width", "0.2",
+                 "--height", "0.3", "--fill", "0.5", "--gravity", "9.81", "--json",
+                 str(out)]) == 0
+    data = json.loads(out.read_text())
+    h = 0.15
+    f1 = math.sqrt(math.pi * 9.81 / 0.4 * math.tanh(math.pi * h / 0.4)) / (2 * math.pi)
+    assert data["modes"][0]["frequency_hz"] == pytest.approx(f1, rel=1e-12)
+    assert data["liquid_mass"] == pytest.approx(998.2 * 0.4 * 0.2 * h, rel=1e-12)
+    assert "closed form" in capsys.readouterr().out

@@ -225,7 +225,8 @@ def test_fill_fraction_outside_unit_interval(tmp_path: Path, fill: str) -> None:
         ('excitation = "measured"', 'excitation = "sine"',
          r'\[test\] excitation: unknown value "sine" \(expected one of "measured", "crank"\)'),
         ('shape = "sphere"', 'shape = "cube"',
-         r'\[tank\] shape: unknown value "cube" \(expected one of "sphere", "cylinder"\)'),
+         r'\[tank\] shape: unknown value "cube" \(expected one of "sphere", "cylinder", '
+         r'"capsule", "rectangular"\)'),
     ],
 )
 def test_unknown_choice(tmp_path: Path, old: str, new: str, pattern: str) -> None:

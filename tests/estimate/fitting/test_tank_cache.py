@@ -84,9 +84,9 @@ def test_case_file_predictions_use_the_cache(tmp_path, monkeypatch):
 
     monkeypatch.setenv("SLOSH_CACHE_DIR", str(tmp_path))
     kw = dict(density=998.2, viscosity=1.0e-6, gravity=9.81)
-    p = tank_prediction("sphere", 0.1016, 0.6, **kw)
+    p = tank_prediction(Sphere(0.1016), 0.6, **kw)
     assert len(list((tmp_path / "tank").glob("*.json"))) == 1
     assert _numbers(p) == _numbers(predict(Sphere(0.1016), fill=0.6, modes=1,
                                            liquid=p.liquid, gravity=9.81))
     with pytest.raises(InputError, match="method must be one of"):
-        tank_prediction("sphere", 0.1016, 0.6, method="magic", **kw)
+        tank_prediction(Sphere(0.1016), 0.6, method="magic", **kw)
