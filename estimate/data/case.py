@@ -21,7 +21,7 @@ CSV file with the measured samples. The format is the one of the estimation issu
     kinematic_viscosity = 1.004e-6   # m^2/s
 
     [rig]
-    dry_mass = 1.2               # kg
+    dry_mass = 1.2               # kg; "estimate" (or absent): not weighed, estimated
     gravity = 9.80665            # m/s^2
 
     [rig.crank]                  # only for excitation = "crank"
@@ -121,6 +121,7 @@ __all__ = [
     "TIME_STEP_RTOL",
     "Case",
     "CaseError",
+    "DRY_MASS_ESTIMATE",
     "Crank",
     "Liquid",
     "Prediction",
@@ -154,6 +155,9 @@ MIN_DURATION: float = 0.1
 """Shortest record [s] (see the module docstring for why)."""
 TIME_STEP_RTOL: float = 1e-3
 """Allowed deviation of each time step from the median step, relative to the median step."""
+DRY_MASS_ESTIMATE: str = "estimate"
+"""``[rig] dry_mass`` of a container that was not weighed (lateral rig): the fit estimates
+the rigid mass; also what an absent key means."""
 
 
 
@@ -240,6 +244,20 @@ class Tank:
     radius: float
     fill_fraction: float
     diaphragm: bool
+
+    def geometry(self):
+        """The tank's geometry (:mod:`analogs.tank`): a sphere, or a cylinder as tall as
+        its diameter. The one place a case's tank becomes a shape: the liquid mass and the
+        modal prediction both ask here."""
+        from analogs.tank import Cylinder, Sphere
+
+        return Sphere(self.radius) if self.shape == "sphere" else Cylinder(self.radius,
+                                                                           2 * self.radius)
+
+    @property
+    def depth(self) -> float:
+        """Liquid depth [m] (``fill_fraction`` of the tank's height)."""
+        return self.fill_fraction * self.geometry().height
 
 
 @dataclass(frozen=True)
@@ -353,8 +371,10 @@ class Rig:
 
     Attributes
     ----------
-    dry_mass : float
-        Mass moving with the tank and seen by the force transducer [kg].
+    dry_mass : float or None
+        Mass moving with the tank and seen by the force transducer [kg]; ``None`` when
+        the container was not weighed (``dry_mass = "estimate"`` or absent, lateral rig
+        only): the fit then estimates it.
     gravity : float
         Gravitational acceleration [m/s^2].
     crank : Crank or None
@@ -363,7 +383,7 @@ class Rig:
         The ``[rig.spin]`` table (spinning rig only).
     """
 
-    dry_mass: float
+    dry_mass: float | None
     gravity: float
     crank: Crank | None = None
     spin: Spin | None = None
@@ -445,6 +465,13 @@ class Case:
     def crank(self) -> Crank | None:
         """The ``[rig.crank]`` table, or None."""
         return self.rig.crank
+
+    @property
+    def liquid_mass(self) -> float:
+        """Mass of the liquid in the tank [kg]: density times the volume below the fill
+        depth of :meth:`Tank.geometry`."""
+        geometry = self.tank.geometry()
+        return self.liquid.density * geometry.volume(self.tank.depth)
 
     @property
     def sample_interval(self) -> float:

@@ -31,11 +31,12 @@ def tank_prediction(shape: str, radius: float, fill: float, *, density: float,
     height, density in kg/m^3, kinematic viscosity in m^2/s, gravity in m/s^2. The modal
     analysis is kept on disk (:mod:`estimate.fitting._tank_cache`): a tank and fill seen
     before costs no solve."""
-    from analogs.tank import METHODS, Cylinder, Liquid, Sphere, predict
+    from analogs.tank import METHODS, Liquid, predict
 
+    from ..data.case import Tank
     from ._tank_cache import CachedSolver
 
-    tank = Sphere(radius) if shape == "sphere" else Cylinder(radius, 2 * radius)
+    tank = Tank(shape, radius, fill, diaphragm).geometry()
     if method not in METHODS:
         raise InputError(f"tank modal analysis method must be one of {', '.join(METHODS)}, "
                          f"got {method!r}")
@@ -215,6 +216,7 @@ def nominal_scale(name: str, value: float, values: Mapping[str, float], gravity:
         "stiffness": m * gravity * L, "diaphragm_stiffness": m * gravity * L,
         "damping": 0.05 * m * L**2 * omega, "diaphragm_damping": 0.05 * m * L**2 * omega,
         "quadratic_damping": 0.05 * m * L**2, "flywheel_angle": 1.0, "omega_correction": 0.1,
+        "lag": 0.01,
     }
     if local in physical:
         return max(abs(value), physical[local])
