@@ -38,6 +38,8 @@ LAG_GRID_STEP = 0.005
 #: The lag is identifiable (estimated in the NLP) when the first stage determines it to this
 #: standard error [s] or better: a 5 ms uncertainty moves a 3 Hz mode's phase by 5 degrees.
 LAG_IDENTIFIED = 0.005
+#: A first-stage slosh mass beyond this share of the liquid mass starts the NLP there.
+BUDGET_SHARE = 0.9
 #: Damping ratios searched.
 ZETA_RANGE = (1e-4, 0.5)
 #: Starting frequencies: the prediction and at most this many force-spectrum peaks within
@@ -100,6 +102,10 @@ class FirstStage:
     #: The swing amplitude of the linear mode [rad]; its frequency was softened back to
     #: the pendulum's small-swing one by the elliptic integral (NaN: not corrected).
     swing: float = math.nan
+    #: Per record, the factor by which the other parameters inflate the lag's variance.
+    lag_inflation: tuple[float, ...] = ()
+    #: The share of the (low-passed) force's variance the linear model explains.
+    explained: float = math.nan
 
     @property
     def lag_identified(self) -> bool:
@@ -250,11 +256,16 @@ def identify(records, *, frequency_hz: float, gravity: float | None = None,
     outcomes.sort(key=lambda o: o[0])
     best_cost, _, best = outcomes[0]
     r, beta = _projected(recs, best.x)
+    F_all = _stacked(recs, best.x)[1]
     n_obs = r.size
     s2 = best_cost / max(n_obs - (2 + n + 3 * n), 1)
     J = best.jac
     cov_x = s2 * np.linalg.pinv(J.T @ J)
     se_x = np.sqrt(np.clip(np.diag(cov_x), 0, None))
+    info = J.T @ J
+    # how much the other parameters inflate each lag's variance (1: none; a steady sine
+    # trades its lag for the mode's phase)
+    vif = np.diag(np.linalg.pinv(info))[2:] * np.diag(info)[2:]
     if noise is not None:
         # what the data determine, not how well a linear mode fits large swings: the
         # lags' standard errors at the force noise (low-passed as the records were)
@@ -280,7 +291,9 @@ def identify(records, *, frequency_hz: float, gravity: float | None = None,
         stderr={"frequency_hz": omega / (2 * math.pi) * se_x[0], "damping_ratio": zeta * se_x[1],
                 "rigid_mass": math.sqrt(max(cov_beta[0, 0], 0.0)),
                 "slosh_mass": math.sqrt(max(cov_beta[1, 1], 0.0))},
-        starts=tuple(out), rms_residual=math.sqrt(best_cost / n_obs), swing=swing)
+        starts=tuple(out), rms_residual=math.sqrt(best_cost / n_obs), swing=swing,
+        lag_inflation=tuple(float(v) for v in vif),
+        explained=1 - best_cost / max(float(np.sum((F_all - F_all.mean()) ** 2)), 1e-300))
 
 
 def _swing(recs, x, gravity: float) -> float:
@@ -429,12 +442,18 @@ def starting_values(stage: FirstStage, *, gravity: float, estimated, values, liq
     estimated, the predicted length kept and the spring taking the rest of the stiffness);
     the hinge damper from the damping ratio; ``rig.dry_mass`` (an unweighed container: the
     rigid mass less the fixed liquid and the other modes) or ``fixed.mass`` (the rigid
-    mass less the dry mass and the other modes). Empty when the stage's slosh mass is not
-    positive or exceeds the liquid."""
+    mass less the dry mass and the other modes). A slosh mass that is not positive leaves
+    the masses to the prediction (the frequency and damping still start the mode); one
+    beyond :data:`BUDGET_SHARE` of the liquid starts there."""
     est = set(estimated)
     m = stage.slosh_mass
-    if not (m > 0) or (liquid_mass is not None and m >= liquid_mass):
-        return {}
+    keep_mass = m > 0
+    if not keep_mass:  # the frequency still holds; the mass stays the prediction's
+        m = float(values.get(f"{host}.mass", math.nan))
+        if not m > 0:
+            return {}
+    if liquid_mass is not None and m >= BUDGET_SHARE * liquid_mass:
+        m = BUDGET_SHARE * liquid_mass  # inside the liquid budget, where IPOPT starts
     omega = 2 * math.pi * stage.frequency_hz
     out: dict[str, float] = {}
     L = gravity / omega**2
@@ -445,7 +464,8 @@ def starting_values(stage: FirstStage, *, gravity: float, estimated, values, liq
             out[f"{host}.stiffness"] = m * L**2 * (omega**2 - gravity / L)
         else:
             out[f"{host}.stiffness"] = 0.0
-    out[f"{host}.mass"] = m
+    if keep_mass:
+        out[f"{host}.mass"] = m
     out[f"{host}.length"] = L
     out[f"{host}.damping"] = 2 * stage.damping_ratio * omega * m * L**2
     others = sum(float(v) for k, v in values.items()
@@ -454,6 +474,8 @@ def starting_values(stage: FirstStage, *, gravity: float, estimated, values, liq
     others += sum(float(values.get(k, 0.0)) for k in est
                   if k.endswith(".mass") and k.split(".")[0] not in ("fixed", "rig", host))
     M = stage.rigid_mass - others
+    if not keep_mass:
+        return {k: v for k, v in out.items() if k in est}
     if "rig.dry_mass" in est:
         fixed = (liquid_mass - m - others) if "fixed.mass" not in est and liquid_mass else \
             float(values.get("fixed.mass", 0.0))
