@@ -29,7 +29,8 @@ from dataclasses import dataclass, field
 
 import numpy as np
 
-__all__ = ["FirstStage", "StartOutcome", "identify", "LAG_RANGE", "LAG_IDENTIFIED"]
+__all__ = ["FirstStage", "StartOutcome", "identify", "record_stage", "starting_values",
+           "forget_stages", "LAG_RANGE", "LAG_IDENTIFIED"]
 
 #: Lags searched [s]: the force stream up to 50 ms ahead of or 150 ms behind the motion.
 LAG_RANGE = (-0.05, 0.15)
@@ -38,6 +39,9 @@ LAG_GRID_STEP = 0.005
 #: The lag is identifiable (estimated in the NLP) when the first stage determines it to this
 #: standard error [s] or better: a 5 ms uncertainty moves a 3 Hz mode's phase by 5 degrees.
 LAG_IDENTIFIED = 0.005
+#: The first stage starts a fit only when its linear model explains this share of the
+#: (low-passed) force: a record whose acceleration is mostly noise (a 0.2 mm sweep) does not.
+MIN_EXPLAINED = 0.5
 #: A first-stage slosh mass beyond this share of the liquid mass starts the NLP there.
 BUDGET_SHARE = 0.9
 #: Damping ratios searched.
@@ -45,7 +49,7 @@ ZETA_RANGE = (1e-4, 0.5)
 #: Starting frequencies: the prediction and at most this many force-spectrum peaks within
 #: FREQUENCY_BAND of it.
 SPECTRAL_STARTS = 3
-FREQUENCY_BAND = (0.3, 3.0)
+FREQUENCY_BAND = (0.3, 2.0)
 #: Two starts disagree when their frequencies differ by more than this (relative) and the
 #: worse one's objective is within SPREAD_CHI2 of the best (in units of the residual
 #: variance): the data then do not prefer one clearly.
@@ -108,6 +112,22 @@ class FirstStage:
     explained: float = math.nan
 
     @property
+    def failure(self) -> str | None:
+        """Why the stage cannot start a fit (``None``: it can): the linear model explains
+        under :data:`MIN_EXPLAINED` of the force, a rigid mass that is not positive, or a
+        lag at the edge of the searched range."""
+        if not self.explained >= MIN_EXPLAINED:
+            return (f"the linear model explains {100 * self.explained:.0f} % of the force "
+                    f"(needs {100 * MIN_EXPLAINED:.0f} %)")
+        if not self.rigid_mass > 0:
+            return f"its rigid mass {self.rigid_mass:.3g} kg is not positive"
+        edge = [t for t in self.lags if not LAG_RANGE[0] + LAG_GRID_STEP < t
+                < LAG_RANGE[1] - LAG_GRID_STEP]
+        if edge:
+            return f"its lag {1e3 * edge[0]:.1f} ms is at the edge of the searched range"
+        return None
+
+    @property
     def lag_identified(self) -> bool:
         """Whether every record's lag is determined to :data:`LAG_IDENTIFIED`."""
         return all(math.isfinite(s) and s <= LAG_IDENTIFIED for s in self.lag_stderr)
@@ -119,6 +139,17 @@ class FirstStage:
         return tuple(s for s in self.starts[1:]
                      if abs(s.frequency_hz / best.frequency_hz - 1) > SPREAD_RELATIVE
                      and s.objective - best.objective < SPREAD_CHI2)
+
+    def to_dict(self) -> dict:
+        """The JSON form (SI units): estimates, the lags, and every start's outcome."""
+        return {"frequency_hz": self.frequency_hz, "damping_ratio": self.damping_ratio,
+                "rigid_mass": self.rigid_mass, "slosh_mass": self.slosh_mass,
+                "lags_s": list(self.lags), "lag_stderr_s": list(self.lag_stderr),
+                "lag_identified": self.lag_identified, "swing_rad": _finite(self.swing),
+                "starts": [{"start_hz": s.start_hz, "frequency_hz": s.frequency_hz,
+                            "damping_ratio": s.damping_ratio, "objective_increase": s.objective}
+                           for s in self.starts],
+                "starts_disagree": bool(self.disagreeing)}
 
     def describe(self) -> str:
         """One sentence for the fit's notes."""
@@ -147,6 +178,10 @@ LOWPASS_FACTOR = 3.0
 LOWPASS_MIN_HZ = 6.0
 #: Then decimated to about this many samples per period of the cutoff.
 SAMPLES_PER_CUTOFF = 5.0
+
+
+def _finite(x: float) -> float | None:
+    return float(x) if math.isfinite(x) else None
 
 
 @dataclass(frozen=True)
@@ -313,15 +348,16 @@ def _swing(recs, x, gravity: float) -> float:
 def _bob_acceleration(a: np.ndarray, dt: float, omega: float, zeta: float) -> np.ndarray:
     """The linear mode's bob acceleration for the acceleration samples ``a`` (m/s^2), from
     rest: ``B/A = (2 zeta omega s + omega^2) / (s^2 + 2 zeta omega s + omega^2)``,
-    discretised by the bilinear transform prewarped at ``omega`` (its resonance lands
-    exactly; ``scipy.signal.bilinear_zpk``) and filtered over the record."""
-    from scipy.signal import bilinear_zpk, lfilter, zpk2tf
+    discretised by the bilinear transform ``s = K (1 - 1/z) / (1 + 1/z)`` prewarped at
+    ``omega`` (``K = omega / tan(omega dt / 2)``: the resonance lands exactly), filtered
+    over the record by ``scipy.signal.lfilter``."""
+    from scipy.signal import lfilter
 
     K = omega / math.tan(min(omega * dt / 2, 1.5))
-    poles = np.roots([1.0, 2 * zeta * omega, omega**2])
-    zd, pd, kd = bilinear_zpk(np.array([-omega / (2 * zeta)]), poles, 2 * zeta * omega, K / 2)
-    b, den = zpk2tf(zd, pd, kd)
-    return lfilter(np.real(b), np.real(den), a - a[0]) + a[0]
+    c, w2 = 2 * zeta * omega, omega**2
+    num = [c * K + w2, 2 * w2, w2 - c * K]
+    den = [K * K + c * K + w2, 2 * (w2 - K * K), K * K - c * K + w2]
+    return lfilter(num, den, a - a[0]) + a[0]
 
 
 def _design(rec: _Record, omega: float, zeta: float, lag: float) -> np.ndarray:
@@ -362,20 +398,27 @@ def _beta_covariance(recs, x, s2: float) -> np.ndarray:
 
 def _lag_profile(recs, x0: np.ndarray) -> np.ndarray:
     """Per record, the lag on a grid over :data:`LAG_RANGE` where the projected objective
-    (the others at ``x0``) is lowest."""
+    (the others at ``x0``) is lowest among lags with positive masses: a drive near one
+    frequency also fits half a period off with the masses' signs flipped."""
     grid = np.arange(LAG_RANGE[0], LAG_RANGE[1] + 0.5 * LAG_GRID_STEP, LAG_GRID_STEP)
     x = x0.copy()
     for i in range(len(recs)):
         costs = []
         for tau in grid:
             x[2 + i] = tau
-            r, _ = _projected(recs[i:i + 1], np.r_[x[:2], tau])
-            costs.append(float(r @ r))
-        x[2 + i] = grid[int(np.argmin(costs))]
+            r, beta = _projected(recs[i:i + 1], np.r_[x[:2], tau])
+            costs.append(float(r @ r) if beta[0] > 0 and beta[1] > 0 else math.inf)
+        if np.isfinite(costs).any():
+            x[2 + i] = grid[int(np.argmin(costs))]
     return x[2:]
 
 
 _RECENT: dict = {}
+
+
+def forget_stages() -> None:
+    """Drop the kept :func:`record_stage` results (benchmarks time a first fit of a record)."""
+    _RECENT.clear()
 
 
 def record_stage(problem_parts, *, frequency_hz: float, gravity: float) -> FirstStage | None:

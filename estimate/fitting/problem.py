@@ -93,6 +93,9 @@ class FitProblem:
     #: Linear bounds over the estimates: the masses within the liquid
     #: (:mod:`estimate.fitting.budget`).
     linear_bounds: tuple[LinearBound, ...] = ()
+    #: The first stage that started the fit (:class:`~estimate.fitting.first_stage.FirstStage`),
+    #: or ``None``.
+    first_stage: object = field(default=None, repr=False)
 
     @classmethod
     def build(cls, cases: Case | Sequence[Case], model: Model, *,
@@ -189,6 +192,10 @@ class FitProblem:
             raise InputError(f"lag must be one of {', '.join(map(repr, LAG_MODES))}, got {lag!r}")
         carriage, noise = _input_estimation(exps, input, force_cutoff_hz)
         stage = _first_stage(cases, model, exps, carriage, noise, w) if first_stage else None
+        stage_note = None
+        if stage is not None and stage.failure is not None:
+            stage_note = f"first stage not used: {stage.failure}; starting from the prediction"
+            stage = None
         measurement, lag_note = _with_lag(measurement, lag, stage, carriage, exps)
         per_case_names = {n for mm in measurement if mm.per_case for n in mm.parameters}
         params = {p.name: p for e in exps for p in e.derived.parameters}
@@ -240,8 +247,7 @@ class FitProblem:
             start |= stage_start
             sources = {**sources, **dict.fromkeys(stage_start, "the first stage")}
             notes.append(stage.describe())
-        if lag_note:
-            notes.append(lag_note)
+        notes += [n for n in (stage_note, lag_note) if n]
         missing = [n for n in names if n not in start]
         if missing:
             why = failure or ("neither `[prediction]` nor the tank modal analysis supplies "
@@ -307,7 +313,7 @@ class FitProblem:
                              "offsets and drifts: `ChannelOffsets()`)")
         notes += _noise_notes(exps, carriage, noise)
         return cls(model, exps, tuple(est), tuple(fixed), force_cutoff_hz, tuple(notes), w,
-                   tuple(measurement), cw, input, carriage, noise, ties, linear)
+                   tuple(measurement), cw, input, carriage, noise, ties, linear, stage)
 
     def channels(self, i: int) -> tuple[str, ...]:
         """Output names fitted for case ``i``: the model's measured outputs the case has."""

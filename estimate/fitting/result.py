@@ -375,6 +375,8 @@ class FitResult:
             "status": self.status,
             "verdict": self.verdict,
             "at_bound": list(self.bounds_reached),
+            "first_stage": (None if self.problem.first_stage is None
+                            else self.problem.first_stage.to_dict()),
             "confounded": self.confounded(),
             "warnings": list(self.warnings),
             "input": self.problem.input,

@@ -169,3 +169,21 @@ def _named_at_the_liquid_bound(res) -> None:
     assert "liquid mass" in res.verdict or not res.converged
     data = json.loads(json.dumps(res.to_dict()))
     assert any("liquid mass" in b for b in data["at_bound"])
+
+
+@pytest.mark.slow
+def test_diagnose_names_the_lag_and_no_physical_cause(tmp_path):
+    """`slosh diagnose` on a transport record starts from the fit's baseline (first stage,
+    liquid budget, stream lag), names the lag as a measurement effect and accepts no
+    physical cause; no model it reports leaves the liquid budget."""
+    from estimate.diagnosis.search import diagnose
+
+    record = tc.transport_record(tmp_path, tc.small_cylinder(), decay=11.8, seed=3)
+    d = diagnose(record.case, progress=False)
+    assert [f.cause for f in d.findings] == ["sensor_delay"]
+    assert "lag" in d.findings[0].evidence and "not a physical cause" in d.findings[0].evidence
+    lag = d.to_dict()["final"]["measurement"]["sensor_delay_s"]
+    assert abs(lag - record.lag) < LAG
+    for res in (d.baseline, d.final):
+        assert res.converged and not res.bounds_reached
+        assert res.value("p1.mass") == pytest.approx(record.truth["p1.mass"], rel=MASS)
