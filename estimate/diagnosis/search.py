@@ -111,7 +111,7 @@ class _Fitter:
         self.bar = bar  # a progress bar counting the fits, or None
 
     def problem(self, model: Model, measurement: Sequence[MeasurementModel], initial,
-                bounds=None, *, weights="default", lag: str = "auto") -> FitProblem:
+                bounds=None, *, weights="default", lag: str = "none") -> FitProblem:
         w = self.weights if weights == "default" else weights
         cutoff = self.cutoff if self.input == "filtered" else "auto"
         prob = FitProblem.build(self.cases, model, measurement=tuple(measurement), weights=w,
@@ -122,7 +122,7 @@ class _Fitter:
 
     def __call__(self, model: Model, measurement: Sequence[MeasurementModel], initial,
                  bounds=None, *, weights="default", warm: FitResult | None = None,
-                 lag: str = "auto") -> FitResult:
+                 lag: str = "none") -> FitResult:
         self.count += 1
         if self.bar is not None:
             self.bar.update()
@@ -262,14 +262,11 @@ def _diagnose(cases, max_bic_change: float, max_rounds: int, segments: int,
     base_evidence = evidence
     predicted = predicted_values(cases[0], model + Pendulum("p2"))
     notes = _bound_notes("baseline", base)
-    lag_found = _lag_finding(fitter, model, base) if _lag_text(base) else None
-    if isinstance(lag_found, str):
-        notes.append(lag_found)
     if cases[0].tank.diaphragm:
         notes.append("the case file says the tank has a diaphragm; the diagnosis starts from the "
                      "free-surface analog and looks for the diaphragm's signature in the data")
     current = base
-    findings: list[Finding] = [lag_found] if isinstance(lag_found, Finding) else []
+    findings: list[Finding] = []
     rounds: list[tuple[CandidateOutcome, ...]] = []
     lateral = all(c.test.rig == "lateral" for c in cases)
     measured = all(c.test.excitation == "measured" for c in cases)
@@ -428,11 +425,6 @@ def _round(fitter: _Fitter, current: FitResult, evidence: Evidence, predicted, g
             achieved = max(achieved, current.objective - out.result.objective)
             if out.result.residual_variance <= NOISE_MARGIN**2:
                 floor = out
-    lags = _lag_text(current)
-    if lateral and not any(o.cause == "sensor_delay" for o in outcomes) and not delays and lags:
-        outcomes.append(CandidateOutcome(
-            "sensor_delay", ("sensor_delay",), rms0, math.nan, math.nan, math.nan,
-            f"not tried: every fit estimates the stream lag ({lags})", "", current))
     if lib is not None and not any(o.rejected is None for o in outcomes):
         # the library route: a hinge torque term no named family describes
         outcomes.append(_try(fitter, _library_proposal(lib, current, evidence, inertia),
@@ -441,41 +433,6 @@ def _round(fitter: _Fitter, current: FitResult, evidence: Evidence, predicted, g
                                  -(o.heldout_chi2 if math.isfinite(o.heldout_chi2) else -1e300),
                                  -(o.gain if math.isfinite(o.gain) else -1e300)))
     return outcomes
-
-
-def _lag_text(res: FitResult) -> str:
-    """The stream lags a fit estimated (``rig.lag`` per case), in words; empty without."""
-    out = []
-    for i, name in enumerate(res.names):
-        if name.split(":")[-1] == "rig.lag":
-            se = res.stderr[i]
-            out.append(f"{name} = {1e3 * res.values[i]:.2f}"
-                       + (f" +/- {1e3 * se:.2f}" if math.isfinite(se) else "") + " ms")
-    return ", ".join(out)
-
-
-def _lag_finding(fitter: _Fitter, model: Model, base: FitResult) -> Finding | str:
-    """What the stream lag the baseline estimates explains: the baseline refitted without
-    it (warm), scored as a candidate is (held-out chi-square, BIC, a lag distinct from
-    zero). A :class:`Finding` (cause ``sensor_delay``: a measurement effect, not a
-    physical one) when it qualifies, else a note."""
-    start = {n: v for n, v in zip(base.names, base.values) if ":" not in n}
-    without = fitter(model, (), start, _bounds_of(base), warm=base, lag="none")
-    rms0, chi0 = heldout(without)
-    rms1, chi1 = heldout(base)
-    lags = [i for i, n in enumerate(base.names) if n.split(":")[-1] == "rig.lag"]
-    dbic = bic(base) - bic(without)
-    distinct = all(abs(base.values[i]) > 2 * base.stderr[i] for i in lags)
-    text = (f"a lag between the displacement and the force streams, estimated with every fit "
-            f"({_lag_text(base)})")
-    if not (without.converged and chi0 - chi1 >= MIN_HELDOUT_CHI2
-            and dbic <= MAX_BIC_CHANGE and distinct):
-        return f"{text}: not significant (held-out chi-square {chi0 - chi1:+.1f} without it)"
-    gain = 1 - rms1 / rms0
-    return Finding("sensor_delay", f"{text}: a measurement effect, not a physical cause; "
-                   f"without it the held-out RMS residual is {rms0:.3g} ({100 * gain:.0f} % "
-                   f"more than {rms1:.3g}, BIC {dbic:+.0f})", ("stream_lag",), rms0, rms1, gain,
-                   dbic)
 
 
 def _bound_notes(label: str, res: FitResult) -> list[str]:

@@ -280,21 +280,35 @@ def identify(records, *, frequency_hz: float, gravity: float | None = None,
                              x_scale=x_scale, method="trf", xtol=1e-6, ftol=1e-8,
                              max_nfev=60)
 
-    x_pred = np.r_[math.log(2 * math.pi * starts[0]), math.log(0.01), np.zeros(n)]
-    x_pred[2:] = _lag_profile(recs, x_pred)
+    def search_without_lag(x0):
+        # the mode alone, the streams taken as synchronous: a steady drive trades a free
+        # lag for the mode's phase, and the data then prefer neither clearly
+        sol = least_squares(lambda y: _projected(recs, np.r_[y, x0[2:]])[0], x0[:2],
+                            bounds=(lo[:2], hi[:2]), x_scale=x_scale[:2], method="trf",
+                            xtol=1e-6, ftol=1e-8, max_nfev=60)
+        sol.x = np.r_[sol.x, x0[2:]]
+        sol.jac = np.hstack([sol.jac, np.zeros((sol.jac.shape[0], n))])
+        return sol
+
     outcomes = []
     for f0 in starts:  # the linear mode from every start: cheap, and no start is needed
-        x0 = x_pred.copy()
-        x0[0] = math.log(2 * math.pi * f0)
-        sol = search(x0)
-        outcomes.append((float(2 * sol.cost), f0, sol))
-    outcomes.sort(key=lambda o: o[0])
+        x0 = np.r_[math.log(2 * math.pi * f0), math.log(0.01), np.zeros(n)]
+        for sol in (search_without_lag(x0), None):
+            if sol is None:
+                x0[2:] = _lag_profile(recs, x0)
+                sol = search(x0)
+            outcomes.append((float(2 * sol.cost), f0, sol))
+    # the best physical outcome (positive masses, lags inside the range) first
+    outcomes.sort(key=lambda o: (not _physical(recs, o[2].x), o[0]))
     best_cost, _, best = outcomes[0]
     r, beta = _projected(recs, best.x)
     F_all = _stacked(recs, best.x)[1]
     n_obs = r.size
     s2 = best_cost / max(n_obs - (2 + n + 3 * n), 1)
     J = best.jac
+    if not np.any(J[:, 2:]):  # the lag was held: its sensitivity there, all free
+        J = least_squares(lambda x: _projected(recs, x)[0], best.x, bounds=(lo, hi),
+                          x_scale=x_scale, max_nfev=1).jac
     cov_x = s2 * np.linalg.pinv(J.T @ J)
     se_x = np.sqrt(np.clip(np.diag(cov_x), 0, None))
     info = J.T @ J
@@ -394,6 +408,13 @@ def _projected(recs, x) -> tuple[np.ndarray, np.ndarray]:
 def _beta_covariance(recs, x, s2: float) -> np.ndarray:
     X, _ = _stacked(recs, x)
     return s2 * np.linalg.pinv(X.T @ X)
+
+
+def _physical(recs, x) -> bool:
+    """Positive rigid and slosh masses and lags off the edges of :data:`LAG_RANGE`."""
+    _, beta = _projected(recs, x)
+    inside = all(LAG_RANGE[0] + LAG_GRID_STEP < t < LAG_RANGE[1] - LAG_GRID_STEP for t in x[2:])
+    return bool(beta[0] > 0 and beta[1] > 0 and inside)
 
 
 def _lag_profile(recs, x0: np.ndarray) -> np.ndarray:

@@ -35,6 +35,11 @@ FILTERED_FORCE_CUTOFF_HZ = 10.0
 #: only in the fit (:mod:`estimate.fitting.balance` rescales it then).
 DISPLACEMENT_FLOOR = 1e-6
 
+#: ``lag="auto"`` estimates a stream lag only where the first stage finds one of at least
+#: this much [s]: a record without one keeps the parameters it always had (a lag the NLP
+#: is free to move otherwise bends around what the model lacks; a sample at 500 Hz).
+LAG_MIN = 0.002
+
 #: How a stream lag between motion and force is treated (see :meth:`FitProblem.build`).
 LAG_MODES = ("auto", "estimate", "none")
 
@@ -153,8 +158,9 @@ class FitProblem:
             A constant lag of the force stream behind the motion stream
             (:class:`~estimate.fitting.measurement.StreamLag`, ``<case>:rig.lag`` in s),
             estimated with the estimated input: ``"auto"`` where the first stage
-            determines it (:data:`~estimate.fitting.first_stage.LAG_IDENTIFIED`),
-            ``"estimate"`` always, ``"none"`` never.
+            determines it (:data:`~estimate.fitting.first_stage.LAG_IDENTIFIED`) at
+            :data:`LAG_MIN` or more (else its profile's value and standard error are in
+            the notes), ``"estimate"`` always, ``"none"`` never.
         first_stage : bool, default True
             Start the first slosh mode, the rigid mass and the lag from a linear
             identification of the records (:mod:`estimate.fitting.first_stage`) rather
@@ -266,12 +272,10 @@ class FitProblem:
                 lo, hi = length_bounds(predicted[n])
                 notes.append(f"`{n}` bounded to +/-20 % of the predicted {predicted[n]:.4g} m")
                 if n in stage_start and not lo < stage_start[n] < hi:
-                    # the record's own mode lies outside: the bounds follow the data
-                    lo, hi = min(lo, length_bounds(stage_start[n])[0]), \
-                        max(hi, length_bounds(stage_start[n])[1])
-                    notes.append(f"`{n}` bounds widened to [{lo:.4g}, {hi:.4g}] m: the first "
-                                 f"stage's mode ({stage_start[n]:.4g} m) lies outside the "
-                                 "prediction's +/-20 %")
+                    # the anchor stays (a length pinned at it is the diagnosis's evidence of
+                    # a stiffness the liquid lacks); the start moves inside
+                    notes.append(f"the first stage's `{n}` ({stage_start[n]:.4g} m) lies "
+                                 "outside the prediction's +/-20 %: started at the bound")
             lo, hi = bounds_user.get(n, (lo, hi))
             x0 = min(max(start[n], lo), hi)
             scale = nominal_scale(n, x0, start, g)
@@ -446,6 +450,11 @@ def _with_lag(measurement: tuple, mode: str, stage, carriage, exps) -> tuple[tup
         why = ("no first stage" if stage is None else "the first stage determines it to "
                + ", ".join(f"{1e3 * s:.3g} ms" for s in stage.lag_stderr))
         return measurement, f"stream lag not estimated: not identifiable from the record ({why})"
+    if mode == "auto" and all(abs(t) < LAG_MIN for t in stage.lags):
+        return measurement, ("stream lag not estimated: the first stage puts it at "
+                             + ", ".join(f"{1e3 * t:.2f} +/- {1e3 * s:.2g} ms" for t, s in
+                                         zip(stage.lags, stage.lag_stderr))
+                             + f", below {1e3 * LAG_MIN:g} ms")
     return measurement + (StreamLag(),), ("stream lag between the displacement and the force "
                                           "estimated (`rig.lag`, per case)")
 

@@ -26,10 +26,8 @@ def test_linearised_delay_profile_finds_the_simulated_delay(tmp_path):
                         pendulums=[pendulum(1.30, 0.0553, 0.01)], seed=17, sensor_delay=0.03)
     fitter = _Fitter([case], [holdout_weights(case.time.size)], "estimated", force_cutoff([case]))
     model = baseline_model(case)
-    # the fits estimate a stream lag themselves where the first stage finds it (issue 25):
-    # the profile is the diagnosis's tool for fits that do not
-    base = fitter(model, (), {}, lag="none")
-    lin = linearise(fitter.problem(model, (), dict(zip(base.names, base.values)), lag="none"),
+    base = fitter(model, (), {})
+    lin = linearise(fitter.problem(model, (), dict(zip(base.names, base.values))),
                     warm_start=base)
     assert lin.objectives(lin.residuals[:, None], base.names)[0] == pytest.approx(
         lin.objective - lin.score(base.names)[0], rel=1e-6)
