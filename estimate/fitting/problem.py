@@ -248,7 +248,8 @@ class FitProblem:
             from .first_stage import starting_values
 
             stage_start = {k: v for k, v in starting_values(
-                stage, gravity=cases[0].rig.gravity, estimated=names, values=start,
+                stage, gravity=cases[0].rig.gravity, estimated=names,
+                values={**start, **exps[0].fixed},
                 liquid_mass=_liquid(cases[0])).items() if k not in given}
             start |= stage_start
             sources = {**sources, **dict.fromkeys(stage_start, "the first stage")}
