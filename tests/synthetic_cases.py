@@ -117,8 +117,9 @@ def rig_record(folder: Path, name: str, drive, *, scale: float = 1.0, zeta: floa
     tone (``tone`` N at scale 1, at ``tone_hz``), displacement noise (m).
 
     ``scale`` scales the 8-inch sphere at 60 % fill geometrically (masses by scale^3,
-    lengths by scale; 4 is a full-size tank near 1 Hz). Returns ``(case, sim, truth)`` with
-    ``truth`` holding the masses (kg), length (m), f1 (Hz) and damping ratio.
+    lengths by scale, the case file's tank radius too; 4 is a full-size tank near 1 Hz).
+    Returns ``(case, sim, truth)`` with ``truth`` holding the masses (kg), length (m), f1
+    (Hz) and damping ratio.
     """
     m_p, L, m_f, dry = 1.30 * scale**3, 0.0553 * scale, 1.5 * scale**3, 1.2 * scale**3
     p = pendulum(m_p, L, zeta)
@@ -128,7 +129,7 @@ def rig_record(folder: Path, name: str, drive, *, scale: float = 1.0, zeta: floa
     case, sim = make_case(folder, name, excitation, pendulums=[p], fixed_mass=m_f, dry_mass=dry,
                           noise=noise, displacement_noise=displacement_noise, seed=seed,
                           tone=ref.Tone(tone * scale**3, tone_hz) if tone else None,
-                          prediction=prediction)
+                          prediction=prediction, radius=0.1016 * scale)
     truth = {"fixed.mass": m_f, "p1.mass": m_p, "p1.length": L, "f1": f1, "zeta": zeta,
              "pendulum": p, "excitation": excitation}
     return case, sim, truth

@@ -71,7 +71,7 @@ def run(args: argparse.Namespace) -> int:
     if args.report or sys.stdout.isatty():
         print(result.report())
     else:
-        print(f"{'converged' if result.converged else 'NOT converged'} ({result.status}), "
+        print(f"{result.verdict}, "
               f"{result.iterations} iterations, {result.seconds:.2f} s, RMS residual "
               f"{result.rms_residual:.4g} N")
         for i, (n, v, u) in enumerate(zip(result.names, result.values, result.units)):

@@ -8,6 +8,7 @@ from dataclasses import replace
 from typing import Any
 
 from .case import (
+    DRY_MASS_ESTIMATE,
     KNOWN_EXCITATIONS,
     KNOWN_INITIAL_STATES,
     KNOWN_RIGS,
@@ -333,18 +334,41 @@ def _read_rig(ck: Checker, doc: Mapping[str, Any], excitation: str | None,
     t = ck.table(doc, "rig", required=True)
     dry = grav = None
     if t is not None:
-        dry = ck.number(t, "rig", "dry_mass", unit="kg", positive=True)
+        dry = _dry_mass(ck, t, rig_kind)
         grav = ck.number(t, "rig", "gravity", unit="m/s^2", positive=True)
     present, crank = _read_crank(ck, doc, required=(excitation == "crank" and t is not None))
     spinning = rig_kind == "spinning"
     spin_present, spin = _read_spin(ck, doc, required=spinning and t is not None)
-    if dry is None or grav is None or (present and crank is None):
+    if dry is _BAD or grav is None or (present and crank is None):
         return None
     if excitation == "crank" and crank is None:
         return None
     if spin_present and spin is None or (spinning and spin is None):
         return None
     return Rig(dry_mass=dry, gravity=grav, crank=crank, spin=spin if spinning else None)
+
+
+_BAD = object()
+
+
+def _dry_mass(ck: Checker, table: Mapping[str, Any], rig_kind: str | None) -> float | None | object:
+    """``[rig] dry_mass``: a positive number (kg), or ``"estimate"`` / absent on the lateral
+    rig (``None``: the container is not weighed, the fit estimates the rigid mass);
+    :data:`_BAD` after a problem."""
+    value = table.get("dry_mass", DRY_MASS_ESTIMATE)
+    if value == DRY_MASS_ESTIMATE:
+        if rig_kind == "spinning":
+            ck.add("[rig] dry_mass", "the spinning rig needs the dry mass (a number in kg): its "
+                   f"force_z and torques cannot tell it from the fixed liquid; found "
+                   f"{'no key' if 'dry_mass' not in table else repr(value)}")
+            return _BAD
+        return None
+    if isinstance(value, str):
+        ck.add("[rig] dry_mass", f'expected a positive number in kg or "{DRY_MASS_ESTIMATE}" '
+               f"(the container is not weighed), found the string {value!r}")
+        return _BAD
+    dry = ck.number(table, "rig", "dry_mass", unit="kg", positive=True)
+    return _BAD if dry is None else dry
 
 
 def _read_prediction(ck: Checker, doc: Mapping[str, Any]) -> tuple[bool, Prediction | None]:

@@ -26,7 +26,7 @@ CSV file with the measured samples. The format is the one of the estimation issu
     kinematic_viscosity = 1.004e-6   # m^2/s
 
     [rig]
-    dry_mass = 1.2               # kg
+    dry_mass = 1.2               # kg; "estimate" (or absent): not weighed, estimated
     gravity = 9.80665            # m/s^2
 
     [rig.crank]                  # only for excitation = "crank"
@@ -156,6 +156,7 @@ __all__ = [
     "TIME_STEP_RTOL",
     "Case",
     "CaseError",
+    "DRY_MASS_ESTIMATE",
     "Crank",
     "Limits",
     "Liquid",
@@ -213,6 +214,9 @@ positive value, largest magnitude, what it is). Wide enough for any tank test or
 enough that products and squares of them stay finite in double precision, and a value in
 the wrong unit or with a slipped exponent (``dry_mass = 1e30``) is refused before any
 computation; the smallest value applies to quantities that must be positive."""
+DRY_MASS_ESTIMATE: str = "estimate"
+"""``[rig] dry_mass`` of a container that was not weighed (lateral rig): the fit estimates
+the rigid mass; also what an absent key means."""
 
 
 
@@ -345,6 +349,11 @@ class Tank:
     def liquid_mass(self, density: float) -> float:
         """Mass of the liquid [kg] of ``density`` [kg/m^3] at :attr:`fill_fraction`."""
         return self.geometry().liquid_mass(self.fill_fraction, density)
+
+    @property
+    def depth(self) -> float:
+        """Liquid depth [m] (``fill_fraction`` of the tank's height)."""
+        return self.fill_fraction * self.geometry().height
 
     @property
     def size_text(self) -> str:
@@ -511,8 +520,10 @@ class Rig:
 
     Attributes
     ----------
-    dry_mass : float
-        Mass moving with the tank and seen by the force transducer [kg].
+    dry_mass : float or None
+        Mass moving with the tank and seen by the force transducer [kg]; ``None`` when
+        the container was not weighed (``dry_mass = "estimate"`` or absent, lateral rig
+        only): the fit then estimates it.
     gravity : float
         Gravitational acceleration [m/s^2].
     crank : Crank or None
@@ -523,7 +534,7 @@ class Rig:
         The ``[rig.limits]`` table when present.
     """
 
-    dry_mass: float
+    dry_mass: float | None
     gravity: float
     crank: Crank | None = None
     spin: Spin | None = None
@@ -610,6 +621,12 @@ class Case:
     def crank(self) -> Crank | None:
         """The ``[rig.crank]`` table, or None."""
         return self.rig.crank
+
+    @property
+    def liquid_mass(self) -> float:
+        """Mass of the liquid in the tank [kg]: density times the volume below the fill
+        depth of :meth:`Tank.geometry`."""
+        return self.tank.liquid_mass(self.liquid.density)
 
     @property
     def sample_interval(self) -> float:

@@ -79,7 +79,7 @@ def model_for_case(model: Model, case: Case) -> Model:
 
 
 def rig_values(case: Case) -> dict[str, float]:
-    """Parameter values the case file fixes: dry mass, gravity and the crank geometry, or
+    """Parameter values the case file fixes: dry mass (when weighed), gravity and the crank geometry, or
     the spinning rig's geometry and constant motion (``[rig.spin]`` -> ``rig.radius``,
     ``rig.height`` and, without measured motion or schedules, ``rig.spin_rate``,
     ``rig.nutation_angle``, ``rig.nutation_frequency``)."""
@@ -93,7 +93,9 @@ def rig_values(case: Case) -> dict[str, float]:
         if spin.gravity_on:
             out["rig.gravity"] = case.rig.gravity
         return out
-    out = {"rig.dry_mass": case.rig.dry_mass, "rig.gravity": case.rig.gravity}
+    out = {"rig.gravity": case.rig.gravity}
+    if case.rig.dry_mass is not None:  # else the container is not weighed: estimated
+        out["rig.dry_mass"] = case.rig.dry_mass
     if case.test.excitation == "crank" and case.crank is not None:
         out |= {"rig.crank_radius": case.crank.radius, "rig.rod_length": case.crank.rod_length,
                 "rig.drive_frequency": case.crank.frequency}

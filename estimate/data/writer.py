@@ -15,8 +15,8 @@ from typing import Any
 import numpy as np
 from numpy.typing import ArrayLike, NDArray
 
-from .case import (LIMIT_UNITS, SHAPE_KEYS, SPINNING_CHANNELS, Case, Liquid, Prediction, Rig,
-                   Tank, TestInfo)
+from .case import (DRY_MASS_ESTIMATE, LIMIT_UNITS, SHAPE_KEYS, SPINNING_CHANNELS, Case, Liquid,
+                   Prediction, Rig, Tank, TestInfo)
 from .reader import load_case
 
 __all__ = ["write_case"]
@@ -77,7 +77,9 @@ def _toml_text(test: TestInfo, tank: Tank, liquid: Liquid, rig: Rig,
              ("diaphragm", tank.diaphragm, "")])
     table("liquid", [("density", liquid.density, "kg/m^3"),
                      ("kinematic_viscosity", liquid.kinematic_viscosity, "m^2/s")])
-    table("rig", [("dry_mass", rig.dry_mass, "kg moving with the tank, seen by the transducer"),
+    dry = (rig.dry_mass, "kg moving with the tank, seen by the transducer") \
+        if rig.dry_mass is not None else (DRY_MASS_ESTIMATE, "not weighed: estimated")
+    table("rig", [("dry_mass", *dry),
                   ("gravity", rig.gravity, "m/s^2")])
     if rig.spin is not None:
         sp = rig.spin

@@ -9,7 +9,7 @@ from dataclasses import dataclass, field
 
 from analogs import HingeDamper, HingeSpring, Model, Pendulum
 
-from ..fitting.measurement import MeasurementModel, SensorDelay
+from ..fitting.measurement import MeasurementModel, SensorDelay, StreamLag
 from ..fitting.result import FitResult
 from .evidence import Evidence
 
@@ -352,8 +352,8 @@ def propose(model: Model, measurement: tuple[MeasurementModel, ...], current: Fi
     """The candidate extensions of ``model`` that the score screening cannot rank (they add
     states, change a held parameter or shift the data): another slosh mode (matched scan),
     a diaphragm's hinge spring with the length held near the prediction, a sensor delay
-    (profiled, when the residual leans toward a late recording) and, on a rotating rig, a
-    rotor. A matched scan's score is the proposal's :attr:`Proposal.score`."""
+    (profiled; unless the fits estimate a stream lag) and, on a rotating rig, a rotor. A
+    matched scan's score is the proposal's :attr:`Proposal.score`."""
     values = dict(zip(current.names, current.values))
     out: list[Proposal] = []
     if len(current.channels[0] if current.channels else ()) > 1:
@@ -467,12 +467,14 @@ def propose(model: Model, measurement: tuple[MeasurementModel, ...], current: Fi
             plausible=plausible_spring, describe=describe_spring))
 
     # -- sensor delay (measurement model, delay profiled) -----------------------------------------
-    # only when the residual leans toward a late recording: the profile costs several fits
-    skewed = evidence.skew_delay >= 1e-3 or evidence.skew_correlation >= 0.15
-    if skewed and not any(isinstance(mm, SensorDelay) for mm in measurement):
+    # always a candidate where the fits do not estimate a stream lag themselves: its
+    # linearised profile (the search's score) decides whether it is fitted, not a dF/dt
+    # correlation, which a 20 ms lag on a transport record left at 0.1 ms
+    if not any(isinstance(mm, (SensorDelay, StreamLag)) for mm in measurement):
         def describe_delay(r: FitResult) -> str:
             tau = next(mm.delay for mm in r.problem.measurement if isinstance(mm, SensorDelay))
-            return (f"the residual correlates with the force's rate of change (r = "
+            return (f"the objective's profile over a delay of the recorded force is lowest "
+                    f"away from zero (residual correlation with dF/dt "
                     f"{evidence.skew_correlation:+.2f}) -> a timing skew; a sensor delay of "
                     f"{1e3 * tau:.1f} ms on the measured force")
 

@@ -144,6 +144,11 @@ def _measurement_dict(res: FitResult) -> dict[str, Any]:
                  "rig.friction_coulomb"):
         if name in res.names:
             out[name] = res.value(name)
+    lags = [n for n in res.names if n.split(":")[-1] == "rig.lag"]
+    for name in lags:  # a stream lag per case ("<case>:rig.lag", s): the force stream late
+        out[name] = res.value(name)
+    if len(lags) == 1 and "sensor_delay_s" not in out:
+        out["sensor_delay_s"] = res.value(lags[0])
     return out
 
 

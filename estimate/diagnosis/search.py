@@ -111,20 +111,22 @@ class _Fitter:
         self.bar = bar  # a progress bar counting the fits, or None
 
     def problem(self, model: Model, measurement: Sequence[MeasurementModel], initial,
-                bounds=None, *, weights="default") -> FitProblem:
+                bounds=None, *, weights="default", lag: str = "none") -> FitProblem:
         w = self.weights if weights == "default" else weights
         cutoff = self.cutoff if self.input == "filtered" else "auto"
         prob = FitProblem.build(self.cases, model, measurement=tuple(measurement), weights=w,
-                                bounds=bounds, force_cutoff_hz=cutoff, input=self.input)
+                                bounds=bounds, force_cutoff_hz=cutoff, input=self.input,
+                                lag=lag)
         known = {e.name for e in prob.estimated}
         return prob.with_initial({k: v for k, v in initial.items() if k in known})
 
     def __call__(self, model: Model, measurement: Sequence[MeasurementModel], initial,
-                 bounds=None, *, weights="default", warm: FitResult | None = None) -> FitResult:
+                 bounds=None, *, weights="default", warm: FitResult | None = None,
+                 lag: str = "none") -> FitResult:
         self.count += 1
         if self.bar is not None:
             self.bar.update()
-        prob = self.problem(model, measurement, initial, bounds, weights=weights)
+        prob = self.problem(model, measurement, initial, bounds, weights=weights, lag=lag)
         # candidates that do not converge quickly are not what the data want; six-channel
         # spinning-rig fits have six times the residuals and start farther (no input)
         if not all(len(e.channels) == 1 for e in prob.experiments):
@@ -259,7 +261,7 @@ def _diagnose(cases, max_bic_change: float, max_rounds: int, segments: int,
     fitter.count += segments
     base_evidence = evidence
     predicted = predicted_values(cases[0], model + Pendulum("p2"))
-    notes = []
+    notes = _bound_notes("baseline", base)
     if cases[0].tank.diaphragm:
         notes.append("the case file says the tank has a diaphragm; the diagnosis starts from the "
                      "free-surface analog and looks for the diaphragm's signature in the data")
@@ -291,6 +293,7 @@ def _diagnose(cases, max_bic_change: float, max_rounds: int, segments: int,
         notes.append(f"the final fit sharpens the dry friction's sign to tanh(rate / "
                      f"{sharpened:g} rad/s) (the candidates' {FRICTION_RATE:g} rad/s biases the "
                      f"friction torque high by a few per cent against sharp friction)")
+    notes += _bound_notes("final model", final)
     final_evidence = collect_evidence(final, segments=evidence.segments)
     verdict = Verdict.of(final_evidence, tuple(rounds), tuple(findings))
     return Diagnosis(base, base_evidence, tuple(findings), final, final_evidence,
@@ -378,6 +381,13 @@ def _round(fitter: _Fitter, current: FitResult, evidence: Evidence, predicted, g
         if p.delay_range is not None:  # its linearised profile predicts what it gains
             profiles[id(p)] = _delay_profile(fitter, current, p.delay_range)
             score = profiles[id(p)].reduction / max(current.residual_variance, 1e-300)
+            if score < MIN_SCORE:  # screened like the families: fitted only when significant
+                outcomes.append(CandidateOutcome(
+                    p.cause, p.added, rms0, math.nan, -math.inf, math.inf,
+                    f"screened: the objective's profile over the delay predicts a reduction of "
+                    f"{score:.1f} (needs {MIN_SCORE:.0f}); best delay "
+                    f"{1e3 * profiles[id(p)].best:.1f} ms", "", current, score=score))
+                continue
         proposals.append((p, score))
     named_best = max((sc.statistic for sc in named if sc.unphysical is None), default=0.0)
     lib = library[0] if library and library[0].statistic >= MIN_SCORE else None
@@ -415,12 +425,6 @@ def _round(fitter: _Fitter, current: FitResult, evidence: Evidence, predicted, g
             achieved = max(achieved, current.objective - out.result.objective)
             if out.result.residual_variance <= NOISE_MARGIN**2:
                 floor = out
-    if lateral and not any(o.cause == "sensor_delay" for o in outcomes) and not delays:
-        outcomes.append(CandidateOutcome(
-            "sensor_delay", ("sensor_delay",), rms0, math.nan, 0.0, 0.0,
-            f"not tried: no timing skew in the residual (correlation with dF/dt "
-            f"{evidence.skew_correlation:+.2f}, implied delay {1e3 * evidence.skew_delay:.1f} ms)",
-            "", current))
     if lib is not None and not any(o.rejected is None for o in outcomes):
         # the library route: a hinge torque term no named family describes
         outcomes.append(_try(fitter, _library_proposal(lib, current, evidence, inertia),
@@ -429,6 +433,12 @@ def _round(fitter: _Fitter, current: FitResult, evidence: Evidence, predicted, g
                                  -(o.heldout_chi2 if math.isfinite(o.heldout_chi2) else -1e300),
                                  -(o.gain if math.isfinite(o.gain) else -1e300)))
     return outcomes
+
+
+def _bound_notes(label: str, res: FitResult) -> list[str]:
+    """A note when ``res`` ends at a bound (a mass, a length, the liquid mass budget)."""
+    reached = res.bounds_reached
+    return [f"the {label} ends at a bound: {'; '.join(reached)}"] if reached else []
 
 
 def _library_proposal(sc, current: FitResult, evidence: Evidence, inertia) -> Proposal:

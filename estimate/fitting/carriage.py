@@ -156,6 +156,22 @@ class CarriageInput:
     at_rest: bool
     coloured_noise: bool = False
     _memo: dict = field(default_factory=dict, compare=False, repr=False)
+    _shift_memo: dict = field(default_factory=dict, compare=False, repr=False)
+
+    def derivative_designs(self, times: np.ndarray, order: int) -> tuple:
+        """``design(times, d) / d!`` for ``d = 0..order`` as sparse CasADi matrices: the
+        Taylor series of the spline shifted in time (a stream lag). Kept with this object."""
+        import math
+
+        from ._sparse import sparse_dm
+
+        t = np.asarray(times, float)
+        key = (t.tobytes(), order)
+        if key not in self._shift_memo:
+            self._shift_memo.clear()
+            self._shift_memo[key] = tuple(sparse_dm(self.design(t, d) / math.factorial(d))
+                                          for d in range(order + 1))
+        return self._shift_memo[key]
 
     @property
     def n_coefficients(self) -> int:

@@ -215,6 +215,7 @@ def nominal_scale(name: str, value: float, values: Mapping[str, float], gravity:
         "stiffness": m * gravity * L, "diaphragm_stiffness": m * gravity * L,
         "damping": 0.05 * m * L**2 * omega, "diaphragm_damping": 0.05 * m * L**2 * omega,
         "quadratic_damping": 0.05 * m * L**2, "flywheel_angle": 1.0, "omega_correction": 0.1,
+        "lag": 0.01,
     }
     if local in physical:
         return max(abs(value), physical[local])

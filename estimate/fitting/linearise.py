@@ -111,8 +111,11 @@ def linearise(problem: FitProblem, *, warm_start: FitResult | None = None,
     jac_g = nlp.constraint_jacobian(True)
     g, Jg = (jac_g(w0, []) if jac_g is not None
              else ca.Function("g", [nlp.w], [nlp.g, ca.jacobian(nlp.g, nlp.w)])(w0))
-    g = np.asarray(g).ravel()
-    kkt = ReducedKKT(Je, scipy_csc(Jg), len(est))
+    # the dynamics only: the liquid mass budget's linear bound is an inequality (the last
+    # rows), not a manifold the states follow
+    n_eq = nlp.g.numel() - nlp.n_linear
+    g, Jg = np.asarray(g).ravel()[:n_eq], scipy_csc(Jg)[:n_eq]
+    kkt = ReducedKKT(Je, Jg, len(est))
     scales = np.array([x.scale for x in est])
     return Linearisation(problem.names, scales, problem.initial, float(e @ e),
                          kkt.gradient(e, g), kkt.information, kkt, e, g)

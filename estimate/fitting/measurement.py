@@ -16,7 +16,12 @@ from scipy.interpolate import CubicSpline
 
 from analogs import Param
 
-__all__ = ["ChannelOffsets", "MeasurementModel", "RigFriction", "SensorDelay", "SensorOffset"]
+__all__ = ["ChannelOffsets", "MeasurementModel", "RigFriction", "SensorDelay", "SensorOffset",
+           "StreamLag", "LAG_BOUND"]
+
+#: Largest stream lag estimated [s] either way (the shift's Taylor series is exact within a
+#: spline piece and loses accuracy beyond a few pieces: at 0.1 s and 3 Hz, 1e-4 of the motion).
+LAG_BOUND = 0.1
 
 
 class MeasurementModel:
@@ -143,3 +148,26 @@ class SensorDelay(MeasurementModel):
         shifted = CubicSpline(t, force)(np.clip(t + self.delay, t[0], t[-1]))
         weights = (t + self.delay <= t[-1]).astype(float)
         return shifted, weights
+
+
+@dataclass(frozen=True)
+class StreamLag(MeasurementModel):
+    """The force and the motion come from two acquisition streams, the force ``rig.lag``
+    seconds behind (a sensor's buffer and filter, another clock): the force recorded at
+    ``t`` belongs to the motion recorded at ``t - lag``.
+
+    It acts on an estimated carriage motion (:mod:`estimate.fitting.carriage`): the spline
+    is the motion in the force stream's time, and the recorded displacement is compared
+    with it ``lag`` later, ``x_rec(t) = s(t + lag)``, written as the spline's Taylor series
+    to the 5th derivative (a quintic spline's exact within a piece). Parameter
+    ``rig.lag`` [s], estimated with the others (positive: the force is late).
+    """
+
+    parameters = {
+        "rig.lag": Param("s", 0.0, -LAG_BOUND, LAG_BOUND,
+                         description="lag of the force stream behind the motion stream"),
+    }
+    #: Derivatives of the Taylor series of the shift.
+    order: int = 5
+
+    per_case = True  # a lag belongs to one record's acquisition

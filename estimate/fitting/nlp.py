@@ -49,6 +49,12 @@ _IPOPT_DEFAULTS = {
     # MUMPS solves these KKT systems accurately: no residual check and refinement of every
     # step (8 % of a fit; the same iterates to 1e-12 of a standard error on six records)
     "ipopt.fast_step_computation": "yes",
+    # a long record's objective sums 1e4 squares: its last digits are round-off, and a
+    # stream lag's bilinear residual leaves the dual infeasibility a hair above 1e-6 while
+    # the line search finds nothing to gain (a 6,900-sample transport record: stuck at
+    # 1.4e-6 from iteration 10, "Error_In_Step_Computation" at 13). Four iterations within
+    # 1e-5 end the fit as "Solved_To_Acceptable_Level" instead.
+    "ipopt.acceptable_tol": 1e-5, "ipopt.acceptable_iter": 4,
 }
 _IPOPT_HINTS = {
     "Maximum_Iterations_Exceeded": "raise `ipopt.max_iter` in solver_options, or start closer "
@@ -77,7 +83,8 @@ def fit(problem: FitProblem, *, transcription: Transcription = MultipleShooting(
         hessian: Hessian = Hessian(), cost: str = "squared", initial_state: str | None = None,
         solver_options: Mapping[str, object] | None = None,
         progress: bool | None = None, robust_start: bool = True,
-        compile_: bool | None = None, warm_start: FitResult | None = None) -> FitResult:
+        compile_: bool | None = None, warm_start: FitResult | None = None,
+        balance: bool = True) -> FitResult:
     """Estimate the parameters of ``problem``.
 
     Parameters
@@ -115,6 +122,11 @@ def fit(problem: FitProblem, *, transcription: Transcription = MultipleShooting(
         A previous fit of the same cases (e.g. of a smaller model): its states start the
         transcription where the coordinates agree and its estimated carriage motion starts
         this one's. The parameters start at ``problem``'s initial values.
+    balance : bool, default True
+        When an estimated carriage motion's displacement residuals come out many times
+        their assumed noise while the force's do not (a planned path given as the
+        displacement), refit once with the displacement noise rescaled
+        (:mod:`estimate.fitting.balance`), from this fit's solution.
 
     Returns
     -------
@@ -162,8 +174,9 @@ def fit(problem: FitProblem, *, transcription: Transcription = MultipleShooting(
     opts.update(dict(solver_options or {}))
     solver = ca.nlpsol("fit", "ipopt", {"x": nlp.w, "f": nlp.f, "g": g}, opts)
     lbx, ubx = nlp.bounds(est)
+    lbg, ubg = nlp.constraint_bounds()
     with surfacing():  # an interrupt inside IPOPT is an interruption, not a non-convergence
-        sol = solver(x0=nlp.w0, lbx=lbx, ubx=ubx, lbg=0, ubg=0)
+        sol = solver(x0=nlp.w0, lbx=lbx, ubx=ubx, lbg=lbg, ubg=ubg)
     if progress:
         print(file=sys.stderr)
     w_opt = np.asarray(sol["x"]).ravel()
@@ -173,6 +186,7 @@ def fit(problem: FitProblem, *, transcription: Transcription = MultipleShooting(
     k = len(terms)
     _, Jg = solver.get_function("nlp_jac_g")(w_opt, [])
     Je, Jg = scipy_csc(out[1]), scipy_csc(Jg)
+    Jg = Jg[: Jg.shape[0] - nlp.n_linear]  # the dynamics; the linear bounds are the masses'
     J = reduced_jacobian(Je, Jg, len(est), scales, list(nlp.free_states))
     carriage = tuple(None if terms[i].carriage is None else np.asarray(out[4 + i])
                      for i in range(k))
@@ -186,10 +200,26 @@ def fit(problem: FitProblem, *, transcription: Transcription = MultipleShooting(
     initial_states = tuple(
         dict(zip(e.derived.states, np.asarray(x, float).ravel().tolist()))
         for e, x in zip(problem.experiments, starts))
-    return _result(problem, theta, solver.stats(), recorder, terms,
-                   *(np.asarray(out[j]).ravel() for j in (0, 2, 3)), J, Je, Jg, t_start,
-                   transcription, cost, carriage, xres, states, coefs, tuple(kinds),
-                   initial_states)
+    result = _result(problem, theta, solver.stats(), recorder, terms,
+                     *(np.asarray(out[j]).ravel() for j in (0, 2, 3)), J, Je, Jg, t_start,
+                     transcription, cost, carriage, xres, states, coefs, tuple(kinds),
+                     initial_states)
+    if balance and cost == "squared":
+        from dataclasses import replace
+
+        from .balance import rebalanced
+
+        again = rebalanced(result)
+        if again is not None:
+            balanced, text = again
+            balanced = replace(balanced.with_initial(dict(zip(result.names, result.values))),
+                               notes=balanced.notes + (text,))
+            result = fit(balanced, transcription=transcription, hessian=hessian, cost=cost,
+                         initial_state=initial_state, solver_options=solver_options,
+                         progress=progress, robust_start=False, compile_=compile_,
+                         warm_start=result, balance=False)
+            result = replace(result, seconds=time.perf_counter() - t_start)
+    return result
 
 
 def _setup(problem: FitProblem, transcription: Transcription, cost: str, kinds: list[str],
@@ -205,7 +235,9 @@ def _setup(problem: FitProblem, transcription: Transcription, cost: str, kinds: 
     warm = _warm_starts(problem, warm_start)
     terms = [case_terms(problem, i, theta_s, transcription, cost, kinds[i],
                         blocks_ok, compile_, warm[i]) for i in range(len(problem.experiments))]
-    return _Nlp.assemble(theta_s, problem.initial / scales, terms), terms
+    rows = np.array([b.row(problem.names) * scales for b in problem.linear_bounds])
+    upper = np.array([b.upper for b in problem.linear_bounds])
+    return _Nlp.assemble(theta_s, problem.initial / scales, terms, rows, upper), terms
 
 
 @dataclass(frozen=True)
@@ -221,9 +253,29 @@ class _Nlp:
     norm: float
     terms: tuple[CaseTerms, ...]
     free_states: tuple[int, ...]
+    #: Linear bounds ``rows @ theta_scaled <= upper`` (the liquid mass budget), the last
+    #: rows of ``g``.
+    rows: np.ndarray
+    upper: np.ndarray
+    theta_s: ca.MX
+
+    @property
+    def n_linear(self) -> int:
+        return int(self.upper.size)
+
+    def constraint_bounds(self) -> tuple[np.ndarray, np.ndarray]:
+        """``lbg, ubg``: the dynamics' equalities, then the linear bounds."""
+        n_eq = self.g.numel() - self.n_linear
+        return (np.r_[np.zeros(n_eq), np.full(self.n_linear, -np.inf)],
+                np.r_[np.zeros(n_eq), self.upper])
+
+    @property
+    def linear_g(self) -> ca.MX:
+        return ca.mtimes(ca.DM(self.rows), self.theta_s) if self.n_linear else ca.MX(0, 1)
 
     @classmethod
-    def assemble(cls, theta_s: ca.MX, theta0: np.ndarray, terms: list[CaseTerms]) -> "_Nlp":
+    def assemble(cls, theta_s: ca.MX, theta0: np.ndarray, terms: list[CaseTerms],
+                 rows: np.ndarray | None = None, upper: np.ndarray | None = None) -> "_Nlp":
         ws, w0s, free = [theta_s], [theta0], []
         offset = theta_s.numel()
         for term in terms:
@@ -240,9 +292,13 @@ class _Nlp:
         n_r = sum(int(t.r.numel()) for t in terms)
         n_f = sum(t.scaled_measured.size for t in terms)
         norm *= n_r / max(n_f, 1)  # keep f = O(1) per sample when displacement terms join
+        upper = np.zeros(0) if upper is None else np.asarray(upper, float)
+        rows = np.zeros((0, theta_s.numel())) if rows is None or not upper.size else rows
         g = ca.vertcat(*[t.block.g for t in terms])
+        if upper.size:
+            g = ca.vertcat(g, ca.mtimes(ca.DM(rows), theta_s))
         return cls(ca.vertcat(*ws), np.concatenate(w0s), g, ca.vertcat(*[t.r for t in terms]),
-                   norm, tuple(terms), tuple(free))
+                   norm, tuple(terms), tuple(free), rows, upper, theta_s)
 
     @property
     def f(self) -> ca.MX:
@@ -252,7 +308,8 @@ class _Nlp:
     def g_fast(self) -> ca.MX:
         """``g`` as IPOPT evaluates it: each block's ``g_fast`` (the compiled RK4 step when
         there is one, so CasADi cannot differentiate it)."""
-        return ca.vertcat(*[t.block.g_fast for t in self.terms if t.block.g.numel()])
+        return ca.vertcat(*[t.block.g_fast for t in self.terms if t.block.g.numel()],
+                          self.linear_g)
 
     @cached_property
     def jac_r(self) -> ca.MX:
@@ -308,7 +365,12 @@ class _Nlp:
         if not rows_t:
             return None
         J = ca.horzcat(ca.vertcat(*rows_t), ca.diagcat(*locals_))
-        return ca.Function("nlp_jac_g", [self.w, ca.MX(0, 1)], [ca.vertcat(*g_jac), J],
+        gv = ca.vertcat(*g_jac)
+        if self.n_linear:
+            J = ca.vertcat(J, ca.horzcat(ca.DM(self.rows), ca.MX(self.n_linear,
+                                                                 J.size2() - self.rows.shape[1])))
+            gv = ca.vertcat(gv, self.linear_g)
+        return ca.Function("nlp_jac_g", [self.w, ca.MX(0, 1)], [gv, J],
                            ["x", "p"], ["g", "jac_g_x"])
 
     def error_function(self, cost: str) -> ca.Function:
@@ -344,7 +406,14 @@ def _result(problem: FitProblem, theta: np.ndarray, stats: dict, recorder: Recor
     unc = uncertainty(Je, Jg, e, n_force + n_disp, theta.size,
                       np.array([x.scale for x in problem.estimated]), problem.names,
                       held=tuple(i for i, side in enumerate(at_bound) if side))
+    active = tuple(b for b in problem.linear_bounds if _on_linear_bound(b, problem, theta))
+    if active:
+        unc = _held_on(unc, np.array([b.row(problem.names) for b in active]))
     warnings = list(unc.warnings)
+    for b in active:
+        warnings.append(f"the estimates end on the bound {b.text}: the data ask for more mass "
+                        "than the liquid holds (check the dry mass, the fill and the density, "
+                        "or a mode the model lacks); held there in the covariance")
     status = stats.get("return_status", "unknown")
     converged = bool(stats.get("success", False))
     if not converged:
@@ -392,6 +461,7 @@ def _result(problem: FitProblem, theta: np.ndarray, stats: dict, recorder: Recor
         dof=max(n_force + n_disp - (Je.shape[1] - Jg.shape[0]), 1),
         initial_state_kinds=initial_state_kinds, initial_states=initial_states,
         at_bound=at_bound, bound_stderr=unc.bound_stderr,
+        active_bounds=tuple(b.text for b in active),
     )
 
 
@@ -410,6 +480,31 @@ def _warm_starts(problem: FitProblem, previous: FitResult | None) -> list:
                 prev = WarmStart(old.derived.coordinates, previous.states[i], coefs)
         out.append(prev)
     return out
+
+
+def _on_linear_bound(bound, problem: FitProblem, theta: np.ndarray) -> bool:
+    """Whether ``theta`` ends on the linear ``bound`` (slack within 1e-4 of its upper)."""
+    return bound.slack(problem.names, theta) <= 1e-4 * max(abs(bound.upper), 1e-12)
+
+
+def _held_on(unc, rows: np.ndarray):
+    """``unc`` with its covariance conditioned on the active linear bounds ``rows``
+    (:func:`estimate.fitting.budget.conditioned`), standard errors and correlations anew."""
+    from dataclasses import replace
+
+    from .budget import conditioned
+
+    free = np.isfinite(unc.stderr)
+    cov = np.zeros_like(unc.covariance)
+    cov[np.ix_(free, free)] = conditioned(unc.covariance[np.ix_(free, free)], rows[:, free])
+    se = np.full(free.size, np.nan)
+    se[free] = np.sqrt(np.clip(np.diag(cov)[free], 0, None))
+    corr = np.full_like(cov, np.nan)
+    with np.errstate(invalid="ignore", divide="ignore"):
+        sub = cov[np.ix_(free, free)] / np.outer(se[free], se[free])
+    corr[np.ix_(free, free)] = np.clip(np.nan_to_num(sub, nan=0.0, posinf=0.0, neginf=0.0),
+                                       -1.0, 1.0)
+    return replace(unc, covariance=cov, stderr=se, correlation=corr)
 
 
 def _at_bound(x, value: float) -> str | None:

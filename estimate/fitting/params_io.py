@@ -50,7 +50,13 @@ def read_params(path: str | Path) -> dict[str, float]:
             out[key] = float(value)
     if problems:
         raise InputError(f"{path}: " + "; ".join(problems))
-    return out
+    return {k: v for k, v in out.items() if not _stream_lag(k)}
+
+
+def _stream_lag(name: str) -> bool:
+    """A stream lag of one record (``<case>:rig.lag``): a property of the recording, not
+    of the analog, which simulations and draws leave out."""
+    return name.split(":")[-1] == "rig.lag"
 
 
 def fit_notes(path: str | Path, *, force: bool = False, what: str = "fit file") -> list[str]:
@@ -225,6 +231,13 @@ def read_fit(path: str | Path) -> Fit:
     names, matrix = _covariance(data.get("covariance"), values, problems)
     if problems:
         raise InputError(f"{path}: " + "; ".join(problems))
+    keep = [i for i, n in enumerate(names) if not _stream_lag(n)]  # marginal of the analog
+    names, matrix = tuple(names[i] for i in keep), np.asarray(matrix)[np.ix_(keep, keep)]
+    values = {k: v for k, v in values.items() if not _stream_lag(k)}
+    estimated = [n for n in estimated if not _stream_lag(n)]
+    for d in (units, lower, upper):
+        for k in [k for k in d if _stream_lag(k)]:
+            del d[k]
     return Fit(path=path, model_spec=str(spec), case=case, values=values, units=units,
                lower=lower, upper=upper, estimated=tuple(estimated), covariance_names=names,
                covariance=matrix)

@@ -16,6 +16,7 @@ from ..data.case import Case
 from ..data.experiment import Experiment, experiment
 from ..data.models import model_for_case
 from ..data.records import refuse_repeated
+from .budget import LinearBound, Tie, liquid_budget
 from .carriage import CarriageInput, RecordNoise, carriage_input, record_noise
 from .free_decay import rest_holds
 from .initial import length_bounds, nominal_scale, predicted_sources, source_notes
@@ -28,6 +29,20 @@ __all__ = ["FitProblem", "Estimated", "PER_CASE", "INPUT_MODES"]
 INPUT_MODES = ("estimated", "filtered")
 #: Force low-pass of the filtered-input mode [Hz] (the seed's workflow).
 FILTERED_FORCE_CUTOFF_HZ = 10.0
+
+#: Floor of the displacement noise [m]: no lab measurement of a carriage's travel is known
+#: to better than a micrometre, and a planned path (the command, smooth to 1e-7 m above
+#: the band) is no measurement of the motion at all; its error (servo lag and ripple) shows
+#: only in the fit (:mod:`estimate.fitting.balance` rescales it then).
+DISPLACEMENT_FLOOR = 1e-6
+
+#: ``lag="auto"`` estimates a stream lag only where the first stage finds one of at least
+#: this much [s]: a record without one keeps the parameters it always had (a lag the NLP
+#: is free to move otherwise bends around what the model lacks; a sample at 500 Hz).
+LAG_MIN = 0.002
+
+#: How a stream lag between motion and force is treated (see :meth:`FitProblem.build`).
+LAG_MODES = ("auto", "estimate", "none")
 
 #: Rig parameters estimated separately for every case (crank phase and speed).
 PER_CASE = ("rig.omega_correction", "rig.flywheel_angle")
@@ -78,6 +93,15 @@ class FitProblem:
     #: removed) and its noise level, which divides the residuals (``None``: the force as
     #: recorded, residuals divided by the default channel scales).
     noise: tuple[RecordNoise | None, ...] = field(default=(), repr=False)
+    #: Model parameters that follow the estimates (:class:`~estimate.fitting.budget.Tie`):
+    #: the fixed liquid of a tank whose container is not weighed.
+    ties: tuple[Tie, ...] = ()
+    #: Linear bounds over the estimates: the masses within the liquid
+    #: (:mod:`estimate.fitting.budget`).
+    linear_bounds: tuple[LinearBound, ...] = ()
+    #: The first stage that started the fit (:class:`~estimate.fitting.first_stage.FirstStage`),
+    #: or ``None``.
+    first_stage: object = field(default=None, repr=False)
 
     @classmethod
     def build(cls, cases: Case | Sequence[Case], model: Model, *,
@@ -89,7 +113,8 @@ class FitProblem:
               measurement: Sequence = (),
               weights: Sequence[np.ndarray | None] | None = None,
               channel_weights: Mapping[str, float] | None = None,
-              input: str = "estimated") -> "FitProblem":
+              input: str = "estimated", lag: str = "auto",
+              first_stage: bool = True) -> "FitProblem":
         """Set up the estimation of ``model`` on ``cases``.
 
         Parameters
@@ -130,6 +155,17 @@ class FitProblem:
             residual by the force noise, both read from the spectra
             (:mod:`estimate.fitting.carriage`); or smoothed and differentiated beforehand
             (:func:`estimate.data.signals.displacement_derivatives`) and treated as exact.
+        lag : {"auto", "estimate", "none"}, default "auto"
+            A constant lag of the force stream behind the motion stream
+            (:class:`~estimate.fitting.measurement.StreamLag`, ``<case>:rig.lag`` in s),
+            estimated with the estimated input: ``"auto"`` where the first stage
+            determines it (:data:`~estimate.fitting.first_stage.LAG_IDENTIFIED`) at
+            :data:`LAG_MIN` or more (else its profile's value and standard error are in
+            the notes), ``"estimate"`` always, ``"none"`` never.
+        first_stage : bool, default True
+            Start the first slosh mode, the rigid mass and the lag from a linear
+            identification of the records (:mod:`estimate.fitting.first_stage`) rather
+            than from the tank prediction (lateral measured cases).
 
         Examples
         --------
@@ -156,6 +192,18 @@ class FitProblem:
         # each case on its own rig (a measured and a crank case share the physical parameters)
         exps = tuple(experiment(c, model_for_case(model, c)) for c in cases)
         measurement = _resolve_channels(tuple(measurement), exps)
+        w = tuple(weights) if weights is not None else tuple(None for _ in exps)
+        if len(w) != len(exps):
+            raise InputError(f"weights: expected one entry per case ({len(exps)}), got {len(w)}")
+        if lag not in LAG_MODES:
+            raise InputError(f"lag must be one of {', '.join(map(repr, LAG_MODES))}, got {lag!r}")
+        carriage, noise = _input_estimation(exps, input, force_cutoff_hz)
+        stage = _first_stage(cases, model, exps, carriage, noise, w) if first_stage else None
+        stage_note = None
+        if stage is not None and stage.failure is not None:
+            stage_note = f"first stage not used: {stage.failure}; starting from the prediction"
+            stage = None
+        measurement, lag_note = _with_lag(measurement, lag, stage, carriage, exps)
         per_case_names = {n for mm in measurement if mm.per_case for n in mm.parameters}
         params = {p.name: p for e in exps for p in e.derived.parameters}
         for mm in measurement:
@@ -190,6 +238,27 @@ class FitProblem:
             v = next((c for c in candidates if c is not None), None)
             if v is not None:
                 start[n] = float(v)
+        ties, linear, budget_notes = liquid_budget(cases, model, names, start)
+        tied = {t.parameter for t in ties}
+        names = [n for n in names if n not in tied]
+        notes += budget_notes
+        if "rig.dry_mass" in names and "rig.dry_mass" not in start:
+            # an unweighed container: a start of the liquid's order (fit's first stage refines it)
+            start["rig.dry_mass"] = _container_guess(cases[0])
+            sources = {**sources, "rig.dry_mass": "a guess (the liquid mass)"}
+        given = set(initial_user) | set(hold) | set(explicit)
+        stage_start = {}
+        if stage is not None:
+            from .first_stage import starting_values
+
+            stage_start = {k: v for k, v in starting_values(
+                stage, gravity=cases[0].rig.gravity, estimated=names,
+                values={**start, **exps[0].fixed},
+                liquid_mass=_liquid(cases[0])).items() if k not in given}
+            start |= stage_start
+            sources = {**sources, **dict.fromkeys(stage_start, "the first stage")}
+            notes.append(stage.describe())
+        notes += [n for n in (stage_note, lag_note) if n]
         missing = [n for n in names if n not in start]
         if missing:
             why = failure or ("neither `[prediction]` nor the tank modal analysis supplies "
@@ -198,7 +267,6 @@ class FitProblem:
             raise InputError(
                 f"no initial value for {', '.join(f'`{n}`' for n in missing)}: {why}; give them "
                 f"with `initial` (e.g. `FitProblem.build(..., initial={{'{missing[0]}': ...}})`)")
-        given = set(initial_user) | set(hold) | set(explicit)
         notes += source_notes(sources, [n for n in names if n not in given])
         g = cases[0].rig.gravity
         est = []
@@ -208,6 +276,11 @@ class FitProblem:
             if n.endswith(".length") and n in predicted and n not in bounds_user:
                 lo, hi = length_bounds(predicted[n])
                 notes.append(f"`{n}` bounded to +/-20 % of the predicted {predicted[n]:.4g} m")
+                if n in stage_start and not lo < stage_start[n] < hi:
+                    # the anchor stays (a length pinned at it is the diagnosis's evidence of
+                    # a stiffness the liquid lacks); the start moves inside
+                    notes.append(f"the first stage's `{n}` ({stage_start[n]:.4g} m) lies "
+                                 "outside the prediction's +/-20 %: started at the bound")
             lo, hi = bounds_user.get(n, (lo, hi))
             x0 = min(max(start[n], lo), hi)
             scale = nominal_scale(n, x0, start, g)
@@ -219,13 +292,16 @@ class FitProblem:
                 targets = [None]
             for i in targets:
                 label = n if i is None else f"{cases[i].test.id}:{n}"
-                est.append(Estimated(label, n, i, p.unit, x0, lo, hi, scale))
+                x0_i = x0
+                if n == "rig.lag" and stage is not None and n not in given:
+                    x0_i = min(max(stage.lags[i], lo), hi)
+                est.append(Estimated(label, n, i, p.unit, x0_i, lo, hi, scale))
         labels = [e.name for e in est]
         if len(set(labels)) != len(labels):
             raise InputError("case ids must be unique when per-case parameters are estimated")
         fixed = []
         for e in exps:
-            vals = {n: v for n, v in start.items() if n not in names}
+            vals = {n: v for n, v in start.items() if n not in names and n not in tied}
             vals |= {n: v for n, v in hold.items()}
             vals |= dict(e.fixed)
             fixed.append(vals)
@@ -244,13 +320,9 @@ class FitProblem:
             raise InputError(f"measurement models {', '.join(single)} apply to the lateral "
                              "force only; remove them for multi-channel cases (their channels' "
                              "offsets and drifts: `ChannelOffsets()`)")
-        w = tuple(weights) if weights is not None else tuple(None for _ in exps)
-        if len(w) != len(exps):
-            raise InputError(f"weights: expected one entry per case ({len(exps)}), got {len(w)}")
-        carriage, noise = _input_estimation(exps, input, force_cutoff_hz)
         notes += _noise_notes(exps, carriage, noise)
         return cls(model, exps, tuple(est), tuple(fixed), force_cutoff_hz, tuple(notes), w,
-                   tuple(measurement), cw, input, carriage, noise)
+                   tuple(measurement), cw, input, carriage, noise, ties, linear, stage)
 
     def channels(self, i: int) -> tuple[str, ...]:
         """Output names fitted for case ``i``: the model's measured outputs the case has."""
@@ -294,10 +366,20 @@ class FitProblem:
         for e, v in zip(self.estimated, theta):
             if e.case is None or e.case == i:
                 vals[e.parameter] = float(v)
+        if self.ties:
+            by_label = {e.name: float(v) for e, v in zip(self.estimated, theta)}
+            vals |= {t.parameter: t.value(by_label) for t in self.ties}
         if model_only:
             known = set(self.experiments[i].derived.parameter_names)
             vals = {k: v for k, v in vals.items() if k in known}
         return vals
+
+    def with_displacement_noise(self, levels: Sequence[float | None]) -> "FitProblem":
+        """A copy whose estimated carriage motions weigh their displacement residuals by
+        other noise levels [m] (``None``: unchanged)."""
+        carriage = tuple(ci if ci is None or lv is None else replace(ci, displacement_noise=lv)
+                         for ci, lv in zip(self.carriage, levels))
+        return replace(self, carriage=carriage)
 
     def with_initial(self, values: Mapping[str, float]) -> "FitProblem":
         """A copy with other initial values for some estimated parameters (by label)."""
@@ -316,7 +398,10 @@ class FitProblem:
                            + ", ".join(self.names))
         est = tuple(e for e in self.estimated if e.name != label)
         fixed = tuple({**f, hit[0].parameter: float(value)} for f in self.fixed)
-        return replace(self, estimated=est, fixed=fixed)
+        return replace(self, estimated=est, fixed=fixed,
+                       ties=tuple(_held_tie(t, label, value) for t in self.ties),
+                       linear_bounds=tuple(b for b in (_held_bound(b, label, value)
+                                                       for b in self.linear_bounds) if b))
 
     @property
     def initial(self) -> np.ndarray:
@@ -327,6 +412,84 @@ class FitProblem:
         bad = [e.name for e in self.estimated if not math.isfinite(e.initial)]
         if bad:
             raise InputError(f"initial values are not finite: {', '.join(bad)}")
+
+
+def _liquid(case: Case) -> float | None:
+    try:
+        return float(case.liquid_mass)
+    except (ValueError, ArithmeticError):
+        return None
+
+
+def _first_stage(cases, model: Model, exps, carriage, noise, weights):
+    """The first stage (:func:`estimate.fitting.first_stage.record_stage`) of lateral
+    measured cases fitted with a first-mode pendulum, else ``None``."""
+    from .first_stage import record_stage
+    from .initial import predicted_values
+
+    if not any(p.name == "p1.length" for p in model.parameters):
+        return None
+    g = cases[0].rig.gravity
+    try:
+        pred = predicted_values(cases[0], model)
+        L, m = pred["p1.length"], pred["p1.mass"]
+        f = math.sqrt(g / L + pred.get("p1.stiffness", 0.0) / (m * L**2)) / (2 * math.pi)
+    except (KeyError, InputError, ValueError, ArithmeticError):
+        f = math.nan
+    return record_stage((exps, carriage, noise, weights), frequency_hz=f, gravity=g)
+
+
+def _with_lag(measurement: tuple, mode: str, stage, carriage, exps) -> tuple[tuple, str | None]:
+    """``measurement`` with a :class:`StreamLag` where ``mode`` asks for one, and a note."""
+    from .measurement import SensorDelay, StreamLag
+
+    if mode == "none" or any(isinstance(m, (StreamLag, SensorDelay)) for m in measurement):
+        return measurement, None
+    estimable = bool(carriage) and all(c is not None for c in carriage)
+    if not estimable:
+        if mode == "estimate":
+            raise InputError("a stream lag is estimated with the estimated carriage motion: "
+                             "build with input='estimated' and measured displacements")
+        return measurement, None
+    if mode == "auto" and (stage is None or not stage.lag_identified):
+        why = ("no first stage" if stage is None else "the first stage determines it to "
+               + ", ".join(f"{1e3 * s:.3g} ms" for s in stage.lag_stderr))
+        return measurement, f"stream lag not estimated: not identifiable from the record ({why})"
+    if mode == "auto" and all(abs(t) < LAG_MIN for t in stage.lags):
+        return measurement, ("stream lag not estimated: the first stage puts it at "
+                             + ", ".join(f"{1e3 * t:.2f} +/- {1e3 * s:.2g} ms" for t, s in
+                                         zip(stage.lags, stage.lag_stderr))
+                             + f", below {1e3 * LAG_MIN:g} ms")
+    return measurement + (StreamLag(),), ("stream lag between the displacement and the force "
+                                          "estimated (`rig.lag`, per case)")
+
+
+def _container_guess(case: Case) -> float:
+    """Start value of an unweighed container's mass [kg]: the liquid's, when the tank
+    geometry gives it, else 1 kg."""
+    try:
+        return float(case.liquid_mass)
+    except (ValueError, ArithmeticError):
+        return 1.0
+
+
+def _held_tie(tie: Tie, label: str, value: float) -> Tie:
+    """``tie`` with the estimate ``label`` held at ``value`` (a constant)."""
+    c = dict(tie.terms).get(label)
+    if c is None:
+        return tie
+    return replace(tie, constant=tie.constant + c * value,
+                   terms=tuple((n, k) for n, k in tie.terms if n != label))
+
+
+def _held_bound(bound: LinearBound, label: str, value: float) -> LinearBound | None:
+    """``bound`` with the estimate ``label`` held at ``value``; ``None`` when nothing
+    estimated is left in it."""
+    c = dict(bound.terms).get(label)
+    if c is None:
+        return bound
+    terms = tuple((n, k) for n, k in bound.terms if n != label)
+    return replace(bound, terms=terms, upper=bound.upper - c * value) if terms else None
 
 
 def _resolve_channels(measurement: tuple, exps: Sequence[Experiment]) -> tuple:
@@ -381,6 +544,8 @@ def _input_estimation(exps: Sequence[Experiment], mode: str, cutoff: float | Non
             ci, rn = carriage_input(case.time, case.displacement, force=case.force,
                                     at_rest=case.test.starts_at_rest,
                                     motion_band_hz=case.test.motion_band_hz)
+            if ci.displacement_noise < DISPLACEMENT_FLOOR:
+                ci = replace(ci, displacement_noise=DISPLACEMENT_FLOOR)
             carriage.append(ci)
             noise.append(rn)
         else:  # crank: the motion is a parametric model; the force's noise weighs it

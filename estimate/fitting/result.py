@@ -33,6 +33,9 @@ def derived_quantities(problem: "FitProblem", theta: np.ndarray, cov: np.ndarray
     for j, e in enumerate(problem.estimated):
         if e.case in (None, 0):
             vals[e.parameter] = th[j]
+    labels = [e.name for e in problem.estimated]
+    for t in problem.ties:
+        vals[t.parameter] = t.constant + sum(k * th[labels.index(n)] for n, k in t.terms)
     found = problem.model.derived_quantities(vals)
     if not found:
         return {}, {}
@@ -126,6 +129,45 @@ class FitResult:
     #: it away from the bound (NaN when they do not determine it), for a one-sided interval.
     at_bound: tuple[str | None, ...] = ()
     bound_stderr: np.ndarray | None = field(default=None, repr=False)
+    #: The linear bounds the estimates end on (the masses within the liquid,
+    #: :mod:`estimate.fitting.budget`), in words; the covariance holds them there.
+    active_bounds: tuple[str, ...] = ()
+
+    @property
+    def bounds_reached(self) -> tuple[str, ...]:
+        """Every bound the fit ends on, in words: estimates at a bound of their own and
+        active linear bounds (the liquid mass budget). Empty: the optimum is interior."""
+        out = []
+        for i, side in enumerate(self.at_bound):
+            if side:
+                e = self.problem.estimated[i]
+                bound = e.lower if side == "lower" else e.upper
+                out.append(f"{e.name} at its {side} bound {bound:.4g} {e.unit}".rstrip())
+        return tuple(out) + tuple(self.active_bounds)
+
+    @property
+    def verdict(self) -> str:
+        """One line: ``converged``, ``converged at a bound: ...`` (naming every bound the
+        fit ends on) or ``NOT converged``, with IPOPT's status."""
+        if not self.converged:
+            return f"NOT converged ({self.status})"
+        reached = self.bounds_reached
+        if reached:
+            return f"converged at a bound ({self.status}): " + "; ".join(reached)
+        return f"converged ({self.status})"
+
+    def tied(self) -> dict[str, tuple[float, float, str]]:
+        """Parameters that follow the estimates (:attr:`FitProblem.ties`: the fixed liquid
+        of an unweighed tank): value, delta-method standard error and what they are."""
+        out = {}
+        by_label = dict(zip(self.names, self.values))
+        for t in self.problem.ties:
+            c = np.zeros(len(self.names))
+            for n, k in t.terms:
+                c[self.names.index(n)] = k
+            cov = np.nan_to_num(self.covariance)
+            out[t.parameter] = (t.value(by_label), float(np.sqrt(max(c @ cov @ c, 0.0))), t.text)
+        return out
 
     def scaled_residuals(self, case: int = 0) -> np.ndarray:
         """Residuals of ``case`` divided by their channel scales (what the cost sums):
@@ -298,6 +340,9 @@ class FitResult:
                 params[name] |= {"at_bound": self.at_bound[i],
                                  "one_sided_95": self.one_sided_limit(name)}
         units = {p.name: p.unit for p in self.problem.experiments[0].derived.parameters}
+        for name, (v, se, text) in self.tied().items():
+            params[name] = {"value": v, "stderr": se, "unit": units.get(name, ""),
+                            "estimated": False, "tied": text}
         needed = set(self.problem.experiments[0].derived.needed_parameters())
         for name, v in self.problem.fixed[0].items():
             if name not in params and name in needed and v is not None and math.isfinite(v):
@@ -328,6 +373,10 @@ class FitResult:
             "seconds": self.seconds,
             "converged": self.converged,
             "status": self.status,
+            "verdict": self.verdict,
+            "at_bound": list(self.bounds_reached),
+            "first_stage": (None if self.problem.first_stage is None
+                            else self.problem.first_stage.to_dict()),
             "confounded": self.confounded(),
             "warnings": list(self.warnings),
             "input": self.problem.input,
@@ -347,8 +396,7 @@ class FitResult:
                  f"    model              = {' + '.join(self.problem.model.names)}",
                  f"    cases              = {', '.join(e.case.test.id for e in self.problem.experiments)}",
                  f"    transcription      = {self.transcription}",
-                 f"    solver status      = {self.status} "
-                 f"({'converged' if self.converged else 'NOT converged'})",
+                 f"    solver status      = {self.verdict}",
                  f"    iterations         = {self.iterations}",
                  f"    wall time          = {self.seconds:.3f} s",
                  f"    data points        = {self.n_samples}",
@@ -367,6 +415,8 @@ class FitResult:
             lo, hi = self.interval(name)
             lines.append(f"    {name:28s} = {v:.6g} +/- {se:.3g} {rel:10s} {e.unit:12s} "
                          f"95%: [{lo:.6g}, {hi:.6g}]  (init {e.initial:.4g})")
+        for name, (v, se, text) in self.tied().items():
+            lines.append(f"    {name:28s} = {v:.6g} +/- {se:.3g} (follows: {text})")
         if self.derived:
             lines.append("[[Derived]]")
             for k, (v, se) in self.derived.items():

@@ -43,11 +43,17 @@ def _parameter_column(dm, values: Mapping[str, float], theta: ca.MX, problem: Fi
                       case: int) -> ca.MX:
     """The model's parameter vector for one case as an MX of the scaled decision vector."""
     entries = []
+    labels = [e.name for e in problem.estimated]
+    ties = {t.parameter: t for t in problem.ties}
     for name in dm.parameter_names:
         hit = None
         for j, e in enumerate(problem.estimated):
             if e.parameter == name and (e.case is None or e.case == case):
                 hit = theta[j] * e.scale
+        if name in ties:  # follows the estimates (the fixed liquid of an unweighed tank)
+            t = ties[name]
+            hit = ca.MX(t.constant) + sum(k * theta[labels.index(n)] * problem.estimated[
+                labels.index(n)].scale for n, k in t.terms)
         if hit is None:
             v = values.get(name)
             hit = ca.MX(0.0 if v is None or not math.isfinite(v) else float(v))
@@ -129,8 +135,14 @@ def case_terms(problem: FitProblem, i: int, theta_s: ca.MX, transcription: Trans
         Ug = ca.reshape(ca.mtimes(A_grid, c), dm.nu, n)
         coefficients = InputCoefficients(c, A_stage)
         coef0 = carriage.coefficients
+        lag0 = _lag_value(problem, i)
         if warm is not None and warm.carriage is not None and warm.carriage.size == coef0.size:
             coef0 = warm.carriage
+        elif lag0:
+            from .measurement import StreamLag
+
+            order = next(m.order for m in problem.measurement if isinstance(m, StreamLag))
+            coef0 = lag_start(carriage, t, lag0, order)
         excitation = carriage.excitation(coef0)
         coef = c
     else:
@@ -185,8 +197,14 @@ def case_terms(problem: FitProblem, i: int, theta_s: ca.MX, transcription: Trans
     report = raw / ca.DM(np.repeat(report_scale, n)) * ca.DM(wv)
     scaled_measured = (F2 / report_scale[None, :]).ravel(order="F")
     x_resid = None
+    lag = _stream_lag(problem, i, theta_s)
     if carriage is not None:
-        x_resid = ca.mtimes(B0, coef) - ca.DM(carriage.displacement)
+        if lag is None:
+            shifted = B0
+        else:  # the recorded displacement is the spline `lag` later: its Taylor series
+            designs = carriage.derivative_designs(t, lag[2].order)
+            shifted = sum((lag[0] ** d * designs[d] for d in range(1, len(designs))), designs[0])
+        x_resid = ca.mtimes(shifted, coef) - ca.DM(carriage.displacement)
         ex = x_resid / carriage.displacement_noise
         e = ca.vertcat(e, ex)
         r = e if cost == "squared" else ca.vertcat(r, ex)
@@ -207,13 +225,57 @@ def case_terms(problem: FitProblem, i: int, theta_s: ca.MX, transcription: Trans
         jlocal = ca.horzcat(jx, jc if jc is not None else ca.MX(jx.size1(), 0))
         if carriage is not None:
             nd = carriage.displacement.size
-            jt = ca.vertcat(jt, ca.MX(nd, jt.size2()))
-            jlocal = ca.vertcat(jlocal, ca.horzcat(ca.MX(nd, jx.size2()),
-                                                   B0 / carriage.displacement_noise))
+            sx = carriage.displacement_noise
+            jt_x = ca.MX(nd, jt.size2())
+            if lag is not None:  # d x_rec / d lag: the shifted spline's velocity
+                tau, j, mm = lag
+                designs = carriage.derivative_designs(t, mm.order)
+                velocity = sum((d * tau ** (d - 1) * designs[d] for d in range(2, len(designs))),
+                               designs[1])
+                scale_j = problem.estimated[j].scale
+                jt_x = ca.horzcat(ca.MX(nd, j), ca.mtimes(velocity, coef) * (scale_j / sx),
+                                  ca.MX(nd, jt.size2() - j - 1))
+            jt = ca.vertcat(jt, jt_x)
+            jlocal = ca.vertcat(jlocal, ca.horzcat(ca.MX(nd, jx.size2()), shifted / sx))
         jac = (jt, jlocal)
     return CaseTerms(block, coef, coef0, r, e, raw, report, F, wts,
                      scaled_measured, initial_state == "free" and dm.nx > 0,
                      None if carriage is None else ca.reshape(Ug, dm.nu, n), x_resid, jac)
+
+
+def _lag_value(problem: FitProblem, i: int) -> float:
+    """The start value of case ``i``'s stream lag [s] (0 when not estimated)."""
+    return next((e.initial for e in problem.estimated
+                 if e.parameter == "rig.lag" and e.case in (None, i)), 0.0)
+
+
+def _stream_lag(problem: FitProblem, i: int, theta_s: ca.MX):
+    """``(lag, index, model)`` when case ``i``'s stream lag is estimated (its value as an
+    expression of the scaled estimates, its index among them, the
+    :class:`~estimate.fitting.measurement.StreamLag`), else ``None``."""
+    from .measurement import StreamLag
+
+    mm = next((m for m in problem.measurement if isinstance(m, StreamLag)), None)
+    if mm is None:
+        return None
+    for j, e in enumerate(problem.estimated):
+        if e.parameter == "rig.lag" and e.case in (None, i):
+            return theta_s[j] * e.scale, j, mm
+    return None
+
+
+def lag_start(carriage, times: np.ndarray, lag: float, order: int) -> np.ndarray:
+    """Start coefficients of the carriage spline when the displacement stream leads the
+    force by ``lag`` seconds: the least-squares spline ``s`` with ``s(t + lag) = x_rec(t)``."""
+    import math
+
+    import scipy.sparse as sps
+    import scipy.sparse.linalg as spla
+
+    B = sum(lag**d / math.factorial(d) * carriage.design(times, d) for d in range(order + 1))
+    A = (B.T @ B).tocsc()
+    A = A + 1e-10 * A.diagonal().mean() * sps.identity(A.shape[0], format="csc")
+    return np.asarray(spla.spsolve(A, B.T @ carriage.displacement)).ravel()
 
 
 @dataclass(frozen=True)

@@ -2,6 +2,7 @@
 
 from __future__ import annotations
 
+import math
 import re
 from pathlib import Path
 
@@ -145,10 +146,32 @@ def test_missing_data_file(tmp_path: Path) -> None:
 
 
 def test_missing_key(tmp_path: Path) -> None:
-    path = _write(tmp_path, GOOD_TOML.replace("dry_mass = 1.2\n", ""))
-    with pytest.raises(CaseError, match=r"A1\.toml: \[rig\] dry_mass: missing key \(expected a "
-                                        r"number in kg\)"):
+    path = _write(tmp_path, GOOD_TOML.replace("gravity = 9.80665\n", ""))
+    with pytest.raises(CaseError, match=r"A1\.toml: \[rig\] gravity: missing key \(expected a "
+                                        r"number in m/s\^2\)"):
         load_case(path)
+
+
+@pytest.mark.parametrize("line", ["", 'dry_mass = "estimate"\n'])
+def test_an_unweighed_container_is_estimated(tmp_path: Path, line: str) -> None:
+    # issue 25: `dry_mass` absent or "estimate": the fit estimates the container's mass
+    case = load_case(_write(tmp_path, GOOD_TOML.replace("dry_mass = 1.2\n", line)))
+    assert case.rig.dry_mass is None
+
+
+def test_a_dry_mass_string_other_than_estimate_is_refused(tmp_path: Path) -> None:
+    path = _write(tmp_path, GOOD_TOML.replace("dry_mass = 1.2", 'dry_mass = "unknown"'))
+    with pytest.raises(CaseError, match=r'\[rig\] dry_mass: expected a positive number in kg or '
+                                        r'"estimate" \(the container is not weighed\), found the '
+                                        r"string 'unknown'"):
+        load_case(path)
+
+
+def test_the_liquid_mass_follows_the_tank_geometry(tmp_path: Path) -> None:
+    # the 8-inch sphere at 60 % depth: a spherical cap pi h^2 (3 R - h) / 3 of water
+    case = load_case(_write(tmp_path, GOOD_TOML))
+    R, h = 0.1016, 0.6 * 2 * 0.1016
+    assert case.liquid_mass == pytest.approx(998.2 * math.pi * h**2 * (3 * R - h) / 3, rel=1e-9)
 
 
 def test_missing_table(tmp_path: Path) -> None:
@@ -358,7 +381,7 @@ def test_table_of_wrong_type(tmp_path: Path) -> None:
 
 
 def test_all_problems_reported_together(tmp_path: Path) -> None:
-    toml = (GOOD_TOML.replace("dry_mass = 1.2\n", "")
+    toml = (GOOD_TOML.replace("gravity = 9.80665\n", "")
             .replace("radius = 0.1016", 'radius = "big"')
             .replace("fill_fraction = 0.6", "fill_fraction = 1.5")
             .replace('shape = "sphere"', 'shape = "cube"')
@@ -370,7 +393,7 @@ def test_all_problems_reported_together(tmp_path: Path) -> None:
         load_case(_write(tmp_path, toml, lines))
     problems = info.value.problems
     expected = [
-        r"A1\.toml: \[rig\] dry_mass: missing key",
+        r"A1\.toml: \[rig\] gravity: missing key",
         r"A1\.toml: \[tank\] radius: expected a number in m, found a string",
         r"A1\.toml: \[tank\] fill_fraction: expected a number strictly between 0 and 1",
         r"A1\.toml: \[tank\] shape: unknown value \"cube\"",

@@ -153,7 +153,12 @@ def test_lab_files_fit_to_the_csv_estimates(lab_cases):
         res = fit(FitProblem.build(load_case(path), model))
         assert res.converged, kind
         assert res.names == ref.names
-        np.testing.assert_allclose(res.values, ref.values, rtol=SAME_FIT_RTOL, err_msg=kind)
+        # the same fit: within SAME_FIT_RTOL, or a millionth of a standard error for an
+        # estimate near zero (a hinge spring at 4e-9 N m/rad: the first stage's SciPy
+        # search turns round-off in the converted units into 1e-15 there)
+        diff = np.abs(res.values - ref.values)
+        assert np.all(diff <= SAME_FIT_RTOL * np.abs(ref.values)
+                      + 1e-6 * np.nan_to_num(ref.stderr)), kind
         np.testing.assert_allclose(res.stderr, ref.stderr, rtol=SAME_FIT_RTOL, err_msg=kind)
 
 

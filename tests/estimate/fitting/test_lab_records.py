@@ -94,9 +94,11 @@ def test_window_of_a_running_sine_test(tmp_path):
 def test_jittered_timestamps_fit_as_the_uniform_record(tmp_path):
     """A transport move (0.4 m in 0.8 s, then 12 s of slosh) at 500 Hz whose timestamps
     are receive times (+/- 1 ms): with `[test] resample_hz = 500` it fits as the same
-    record on its true uniform times (every estimate within 0.1 standard errors: the line
-    through 6900 stamps places them to ~2e-5 s; measured 0.07 at most), and the report says
-    what was done."""
+    record on its true uniform times (every estimate within 0.25 standard errors: the line
+    through 6900 stamps places them to ~2e-5 s; measured 0.07 at most without a lag, 0.21
+    (`p1.length`, 2.3e-7 m) since the transducer's 3.8 ms group delay is estimated as a
+    stream lag, which shrinks the length's standard error to 1.1e-6 m), and the report
+    says what was done."""
     tank = lab.SMALL
     rec = lab.transport(tank, lag=0.0)
     true = _fit(_case(tmp_path, "uniform", rec, tank))
@@ -104,7 +106,7 @@ def test_jittered_timestamps_fit_as_the_uniform_record(tmp_path):
                           resample_hz=500.0))
     assert true.converged and jittered.converged
     z = (jittered.values - true.values) / true.stderr
-    assert np.all(np.abs(z[np.isfinite(z)]) < 0.1), dict(zip(true.names, z))
+    assert np.all(np.abs(z[np.isfinite(z)]) < 0.25), dict(zip(true.names, z))
     assert any("receive times of uniformly taken samples" in n for n in jittered.problem.notes)
     assert "jitter" in jittered.report()
 
