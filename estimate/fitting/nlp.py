@@ -13,7 +13,7 @@ import math
 import sys
 import time
 from collections.abc import Mapping
-from dataclasses import dataclass
+from dataclasses import dataclass, replace
 from functools import cached_property
 
 import casadi as ca
@@ -27,6 +27,7 @@ from ..interrupts import surfacing
 from ._progress import Recorder, progress_printer
 from ._sparse import scipy_csc
 from .covariance import reduced_jacobian, uncertainty
+from .noise_figures import case_figures, reweighed
 from .problem import FitProblem
 from .result import FitResult, derived_quantities
 from .terms import CaseTerms, case_terms
@@ -182,10 +183,19 @@ def fit(problem: FitProblem, *, transcription: Transcription = MultipleShooting(
     initial_states = tuple(
         dict(zip(e.derived.states, np.asarray(x, float).ravel().tolist()))
         for e, x in zip(problem.experiments, starts))
-    return _result(problem, theta, solver.stats(), recorder, terms,
-                   *(np.asarray(out[j]).ravel() for j in (0, 2, 3)), J, Je, Jg, t_start,
-                   transcription, cost, carriage, xres, states, coefs, tuple(kinds),
-                   initial_states)
+    result = _result(problem, theta, solver.stats(), recorder, terms,
+                     *(np.asarray(out[j]).ravel() for j in (0, 2, 3)), J, Je, Jg, t_start,
+                     transcription, cost, carriage, xres, states, coefs, tuple(kinds),
+                     initial_states)
+    again = reweighed(problem, result.noise_figures)  # a provisional force weight was off
+    if again is None:
+        return result
+    second = fit(again.with_initial(dict(zip(result.names, result.values))),
+                 transcription=transcription, hessian=hessian, cost=cost,
+                 initial_state=initial_state, solver_options=solver_options, progress=progress,
+                 robust_start=False, compile_=compile_, warm_start=result)
+    return replace(second, iterations=result.iterations + second.iterations,
+                   seconds=time.perf_counter() - t_start)
 
 
 def _setup(problem: FitProblem, transcription: Transcription, cost: str, kinds: list[str],
@@ -337,9 +347,13 @@ def _result(problem: FitProblem, theta: np.ndarray, stats: dict, recorder: Recor
     n_force = int(sum(np.count_nonzero(w) * c for w, c in zip(weights, nch)))
     n_disp = sum(x.size for x in displacement_residuals if x is not None)
     at_bound = tuple(_at_bound(x, v) for x, v in zip(problem.estimated, theta))
+    # the scores of the robust covariance are read from the measured channels' rows
+    samples = [np.r_[np.tile(np.arange(np.shape(m)[0]), c),
+                     np.full(0 if x is None else x.size, -1)]
+               for m, c, x in zip(measured, nch, displacement_residuals)]
     unc = uncertainty(Je, Jg, e, n_force + n_disp, theta.size,
                       np.array([x.scale for x in problem.estimated]), problem.names,
-                      held=tuple(i for i, side in enumerate(at_bound) if side))
+                      held=tuple(i for i, side in enumerate(at_bound) if side), samples=samples)
     warnings = list(unc.warnings)
     status = stats.get("return_status", "unknown")
     converged = bool(stats.get("success", False))
@@ -354,14 +368,22 @@ def _result(problem: FitProblem, theta: np.ndarray, stats: dict, recorder: Recor
     F_all = np.concatenate([t.scaled_measured[np.tile(t.weights, c) > 0]
                             for t, c in zip(terms, nch)])
     ssr = float(report @ report)
-    derived, derived_units = derived_quantities(problem, theta, unc.covariance,
-                                                np.array([side is None for side in at_bound]))
+    # the intervals use the robust covariance: the Gauss-Newton one when the residuals are
+    # white, wider when they are correlated (coloured noise, a filtered force, a model that
+    # misses a small effect), where the Gauss-Newton one is optimistic
+    kind = "robust" if unc.robust is not None else "gauss-newton"
+    cov = unc.robust if unc.robust is not None else unc.covariance
+    free = np.array([side is None for side in at_bound])
+    stderr = np.where(free, np.sqrt(np.clip(np.diag(cov), 0, None)), np.nan)
+    derived, derived_units = derived_quantities(problem, theta, cov, free)
     pieces = np.split(raw, np.cumsum([int(np.size(m)) for m in measured])[:-1])
     residuals = tuple(p if np.ndim(m) == 1 else p.reshape(m.shape, order="F")
                       for p, m in zip(pieces, measured))
+    figures = tuple(case_figures(problem, i, r, w)
+                    for i, (r, w) in enumerate(zip(residuals, weights)))
     return FitResult(
         problem=problem,
-        values=theta, stderr=unc.stderr, covariance=unc.covariance,
+        values=theta, stderr=stderr, covariance=cov,
         cost=ssr, rms_residual=math.sqrt(ssr / n_force),
         r_squared=1 - ssr / float(np.sum((F_all - F_all.mean()) ** 2)),
         n_samples=n_force, iterations=int(stats.get("iter_count", len(recorder.costs))),
@@ -381,7 +403,9 @@ def _result(problem: FitProblem, theta: np.ndarray, stats: dict, recorder: Recor
         objective=float(e @ e), residual_variance=unc.sigma2,
         dof=max(n_force + n_disp - (Je.shape[1] - Jg.shape[0]), 1),
         initial_state_kinds=initial_state_kinds, initial_states=initial_states,
-        at_bound=at_bound, bound_stderr=unc.bound_stderr,
+        at_bound=at_bound, bound_stderr=unc.bound_stderr, noise_figures=figures,
+        gauss_newton_covariance=unc.covariance, robust_covariance=unc.robust,
+        covariance_kind=kind, bandwidths=unc.bandwidths,
     )
 
 
