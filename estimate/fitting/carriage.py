@@ -355,6 +355,15 @@ _RECENT: dict = {}
 _RECENT_SIZE = 4
 
 
+def adopt_noise(old: RecordNoise, new: RecordNoise) -> None:
+    """Keep ``new`` in place of ``old`` among the kept :func:`carriage_input` results: later
+    problems built on the same record are weighed by ``new`` at once (a figure read from a
+    fit's residual, :func:`estimate.fitting.noise_figures.reweighed`)."""
+    for key, (ci, rn) in list(_RECENT.items()):
+        if rn is old:
+            _RECENT[key] = (ci, new)
+
+
 def forget_records() -> None:
     """Drop the kept :func:`carriage_input` results (benchmarks time a first fit of a
     record with it)."""

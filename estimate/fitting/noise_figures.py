@@ -10,7 +10,8 @@ and the campaign:
 * otherwise a first fit is weighed by the force's white level above the signal band (a
   provisional figure), and the figure is read from that fit's residual
   (:func:`~estimate.data.signals.noise_figure.residual_noise`); when the two differ by more
-  than :data:`REWEIGH_TOLERANCE` the fit is repeated once, weighed by the residual's figure.
+  than :data:`REWEIGH_TOLERANCE` the fit is repeated once, weighed by the residual's figure,
+  and later fits of the record (a diagnosis fits many models to it) start weighed by it.
 
 "x the noise" (:func:`residual_over_noise`) is the RMS residual on the fitted samples over
 the figure: the two numbers the reports print.
@@ -26,6 +27,7 @@ from typing import TYPE_CHECKING
 import numpy as np
 
 from ..data.signals.noise_figure import NoiseFigure, residual_noise
+from .carriage import adopt_noise
 
 if TYPE_CHECKING:  # pragma: no cover
     from .problem import FitProblem
@@ -93,5 +95,6 @@ def reweighed(problem: "FitProblem", figures: tuple[Mapping[str, NoiseFigure], .
             continue
         if abs(fig.std / rn.force_noise - 1.0) > REWEIGH_TOLERANCE:
             noise[i] = rn.weighed_by(fig)
+            adopt_noise(rn, noise[i])  # the record's later fits start weighed by it
             changed = True
     return replace(problem, noise=tuple(noise)) if changed else None

@@ -47,8 +47,8 @@ SETTLED_VARIANCE_RATIO = 2.0
 REST_SIGMAS = 6.0
 #: A quiet segment stops this long before the displacement leaves rest (at least), and this
 #: fraction of the rest: the force sees a smooth start before the displacement does.
-REST_MARGIN_SECONDS = 0.15
-REST_MARGIN_FRACTION = 0.2
+REST_MARGIN_SECONDS = 0.25
+REST_MARGIN_FRACTION = 0.4
 #: A segment is not quiet when one sinusoid (in the band of the mechanics, two cycles at
 #: least) explains more than this many times the share of its variance that the best
 #: sinusoid takes of pure noise...
