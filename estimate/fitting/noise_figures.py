@@ -10,7 +10,8 @@ and the campaign:
 * otherwise a first fit is weighed by the force's white level above the signal band (a
   provisional figure), and the figure is read from that fit's residual
   (:func:`~estimate.data.signals.noise_figure.residual_noise`); when the two differ by more
-  than :data:`REWEIGH_TOLERANCE` the fit is repeated once, weighed by the residual's figure,
+  than a factor :data:`REWEIGH_TOLERANCE` the fit is repeated once, weighed by the
+  residual's figure,
   and later fits of the record (a diagnosis fits many models to it) start weighed by it.
 
 "x the noise" (:func:`residual_over_noise`) is the RMS residual on the fitted samples over
@@ -36,9 +37,12 @@ if TYPE_CHECKING:  # pragma: no cover
 __all__ = ["REWEIGH_TOLERANCE", "case_figures", "residual_over_noise", "reweighed"]
 
 #: A fit weighed by a provisional force noise is repeated, weighed by its residual's figure,
-#: when the two differ by more than this fraction (the weight sets how much the estimated
-#: carriage motion follows the force rather than the displacement).
-REWEIGH_TOLERANCE = 0.2
+#: when the two differ by more than this factor (the weight sets how much the estimated
+#: carriage motion follows the force rather than the displacement). A transducer's low-pass
+#: puts the provisional white level 4-10 times below the noise in the band; a model that is
+#: still wrong (a diagnosis's baseline) leaves a figure some 30 % high, and re-weighing by
+#: it moved such a baseline to another local optimum.
+REWEIGH_TOLERANCE = 2.0
 
 
 def case_figures(problem: "FitProblem", case: int, residual: np.ndarray,
@@ -81,7 +85,8 @@ def residual_over_noise(result: "FitResult", case: int = 0) -> float:
 def reweighed(problem: "FitProblem", figures: tuple[Mapping[str, NoiseFigure], ...]
               ) -> "FitProblem | None":
     """A copy of ``problem`` whose force residuals are weighed by the residual ``figures``
-    where a provisional weight differs from them by more than :data:`REWEIGH_TOLERANCE`;
+    where a provisional weight differs from them by more than a factor
+    :data:`REWEIGH_TOLERANCE`;
     ``None`` when none does (or the weights already came from a residual)."""
     if not problem.noise:
         return None
@@ -93,7 +98,7 @@ def reweighed(problem: "FitProblem", figures: tuple[Mapping[str, NoiseFigure], .
         fig = next(iter(figures[i].values()), None) if i < len(figures) else None
         if fig is None or not math.isfinite(fig.std) or fig.std <= 0:
             continue
-        if abs(fig.std / rn.force_noise - 1.0) > REWEIGH_TOLERANCE:
+        if not 1.0 / REWEIGH_TOLERANCE <= fig.std / rn.force_noise <= REWEIGH_TOLERANCE:
             noise[i] = rn.weighed_by(fig)
             adopt_noise(rn, noise[i])  # the record's later fits start weighed by it
             changed = True

@@ -338,5 +338,5 @@ def residual_noise(time: ArrayLike, residual: ArrayLike, weights: ArrayLike | No
     ar = _yule_walker(acov, n_kept)
     secs = len(starts) * nper * step
     return NoiseFigure(math.sqrt(variance), "residual", ar, secs,
-                       f"fit residual without its spectral peaks and bursts "
-                       f"({len(starts)} segments of {nper * step:.3g} s)")
+                       f"fit residual without its spectral peaks and bursts, "
+                       f"{len(starts)} segments of {nper * step:.3g} s")

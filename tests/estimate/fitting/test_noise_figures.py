@@ -127,3 +127,24 @@ def test_a_filtered_force_makes_the_gauss_newton_errors_optimistic(short_sine):
     assert "optimistic" in res.covariance_note()
     d = res.to_dict()["parameters"]["p1.mass"]
     assert d["stderr"] == d["stderr_robust"] > 1.5 * d["stderr_gauss_newton"]
+
+
+def test_without_a_rest_the_figure_is_read_from_the_residual_and_reweighs(tmp_path):
+    """A transducer record whose move starts 0.3 s in (no quiet segment long enough): the
+    provisional white level above the band is far below the noise, so the first fit's
+    residual gives the figure, and the fit is repeated weighed by it. The figure is within
+    25 % of the true in-band noise."""
+    from estimate.fitting.measurement import ChannelOffsets, SensorDelay
+
+    case, truth = rig_transport(tmp_path, "norest", seed=4, duration=6.0, rest=0.3)
+    problem = FitProblem.build(case, model_from_spec("fixed,p1:nospring", case),
+                               measurement=(ChannelOffsets(drift=False),
+                                            SensorDelay(truth["delay"])))
+    assert problem.noise[0].figure.source == "spectrum"
+    assert problem.noise[0].force_noise < 0.5 * truth["noise"]
+    res = fit(problem, progress=False)
+    fig = res.noise_figure()
+    assert fig.source == "residual"
+    assert res.problem.noise[0].figure is not None
+    assert res.problem.noise[0].figure.source == "residual"  # re-weighed by it
+    assert fig.std == pytest.approx(truth["noise"], rel=0.25)
