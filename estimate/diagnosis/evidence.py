@@ -138,6 +138,13 @@ class Evidence:
     #: Where the residual concentrates: frequencies (Hz) of its strongest spectral peaks.
     residual_frequencies: tuple[float, ...] = ()
 
+    def against(self, noise: float) -> "Evidence":
+        """This evidence measured against the noise figure ``noise`` (N, or channel scales):
+        a diagnosis states every fit of a record against one figure, its final model's."""
+        if not math.isfinite(noise) or noise <= 0 or self.channel_share:
+            return self
+        return replace(self, noise_rms=noise, noise_ratio=self.rms_residual / noise)
+
     @property
     def within_noise(self) -> bool:
         """The residual is within :data:`NOISE_MARGIN` of the measurement noise."""
