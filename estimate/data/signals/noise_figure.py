@@ -27,7 +27,7 @@ from dataclasses import dataclass
 
 import numpy as np
 from numpy.typing import ArrayLike
-from scipy import linalg, signal
+from scipy import linalg, signal, stats
 from scipy.ndimage import median_filter
 
 from ._common import _as_uniform
@@ -40,6 +40,9 @@ QUIET_MIN_SAMPLES = 64
 #: The quarters of a quiet segment have variances within this ratio (noise is stationary; a
 #: force that starts to follow the motion is not).
 QUIET_VARIANCE_RATIO = 4.0
+#: ... and the half nearest the motion is not noisier than the other by an F-test at this
+#: level (a force that starts to follow a smooth start grows).
+QUIET_F_LEVEL = 0.001
 #: A settled end's variance is at most this many times that of the rest before the drive.
 SETTLED_VARIANCE_RATIO = 2.0
 #: The carriage is at rest while its displacement stays within this many displacement noise
@@ -187,7 +190,7 @@ def quiet_segments(time: ArrayLike, displacement: ArrayLike | None, values: Arra
             # steady on a short window, and it must not be noisier than the rest before
             seg = (t.size - keep, t.size)
             piece = y[seg[0]:seg[1]]
-            if _quiet(t[seg[0]:seg[1]], piece, band_hz, cycles=1.0) and (
+            if _quiet(t[seg[0]:seg[1]], piece[::-1], band_hz, cycles=1.0) and (
                     not out or _variance(piece) <= SETTLED_VARIANCE_RATIO * _variance(
                         y[out[0][0]:out[0][1]])):
                 out.append(seg)
@@ -207,13 +210,19 @@ def _variance(y: np.ndarray) -> float:
 
 
 def _quiet(t: np.ndarray, y: np.ndarray, band_hz: float, cycles: float = 2.0) -> bool:
-    """Whether ``y`` looks like stationary noise: its quarters (each about its own line)
-    have variances within :data:`QUIET_VARIANCE_RATIO` of each other, and no sinusoid below
-    ``band_hz`` stands out (:data:`SINE_SHARE_FACTOR`)."""
-    quarters = [_detrended(q) for q in np.array_split(y, 4)]
-    v = np.array([float(q @ q) / max(q.size - 2, 1) for q in quarters])
+    """Whether ``y`` looks like stationary noise: its quarters (about the segment's straight
+    line) have variances within :data:`QUIET_VARIANCE_RATIO` of each other, its second half
+    is not noisier than its first (:data:`QUIET_F_LEVEL`), and no sinusoid below ``band_hz``
+    stands out (:data:`SINE_SHARE_FACTOR`). The rest before the drive is tested as is, the
+    settled end reversed (its part nearest the motion first)."""
+    d = _detrended(y)  # quarters and halves about the segment's line, not their own
+    v = np.array([float(q @ q) / q.size for q in np.array_split(d, 4)])
     if v.min() <= 0 or v.max() > QUIET_VARIANCE_RATIO * v.min():
         return False
+    first, second = np.array_split(d, 2)
+    ratio = (float(second @ second) / second.size) / (float(first @ first) / first.size)
+    if ratio > stats.f.ppf(1.0 - QUIET_F_LEVEL, second.size - 1, first.size - 1):
+        return False  # the part nearest the motion is noisier: the force follows it
     share, expected = _sine_share(t, y, band_hz, cycles)
     return share <= max(SINE_SHARE_FACTOR * expected, SINE_SHARE_MAX)
 
