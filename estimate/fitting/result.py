@@ -330,6 +330,17 @@ class FitResult:
             ratio = rb / gn
         return {n: float(r) for n, r in zip(self.names, ratio) if np.isfinite(r) and r > factor}
 
+    def interval_note(self) -> str:
+        """One sentence: which covariance the standard errors come from, and where the
+        Gauss-Newton ones are optimistic."""
+        if self.covariance_kind != "robust":
+            return "Standard errors: Gauss-Newton covariance (independent residuals)."
+        worse = self.optimistic()
+        return ("Standard errors: the covariance robust to correlated residuals (Newey-West); "
+                + ("the Gauss-Newton ones, which assume independent residuals, are optimistic: "
+                   + ", ".join(f"{r:.2g}x smaller for `{n}`" for n, r in worse.items()) + "."
+                   if worse else f"the Gauss-Newton ones agree within {OPTIMISTIC_FACTOR:g}x."))
+
     def covariance_note(self) -> str:
         """Which covariance the standard errors and intervals come from, and why."""
         p = self.problem
