@@ -17,6 +17,7 @@ import tempfile
 from pathlib import Path
 from typing import Any
 
+from ..diagnosis.evidence import NOISE_MARGIN
 from ..inputs import load_json
 from .discovery import Setup
 from .outliers import FAMILY_ERROR, MIN_RECORDS
@@ -28,10 +29,10 @@ from .table import CampaignTable, campaign_table, quantity_column
 
 __all__ = ["MANIFEST", "MISFIT_RATIO", "OUTPUTS", "claim_folder", "summary", "write_outputs"]
 
-#: A fit that explains a record leaves an RMS residual at or below the white force noise
-#: read above the signal band (0.67-0.97 on the bundled campaign); a residual 20 % above it
-#: is signal the model misses, and the report lists the record.
-MISFIT_RATIO = 1.2
+#: A fit that explains a record leaves an RMS residual of about its noise figure
+#: (:mod:`estimate.fitting.noise_figures`); above the diagnosis's margin it is signal the
+#: model misses, and the report lists the record.
+MISFIT_RATIO = NOISE_MARGIN
 #: Output files of a campaign folder besides the store.
 OUTPUTS = ("campaign.csv", "campaign.parquet", "report")
 #: The file naming the campaign a folder belongs to.

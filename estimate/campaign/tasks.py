@@ -109,8 +109,9 @@ def _fit(task: Task) -> dict[str, Any]:
     model = model_from_spec(task.model, cases[0])
     result = fit(FitProblem.build(cases, model, input=task.input), progress=False)
     params, derived = _quantities(result)
-    noise = [n.force_noise if n is not None else math.nan
-             for n in (result.problem.noise or [None] * len(cases))]
+    # each record's noise figure, the one the fit report and the diagnosis print
+    noise = [f.std if (f := result.noise_figure(i)) is not None else math.nan
+             for i in range(len(cases))]
     n = [int(c.n_samples) for c in cases]
     pooled = math.sqrt(sum(k * s**2 for k, s in zip(n, noise)) / sum(n))
     return {

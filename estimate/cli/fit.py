@@ -74,6 +74,11 @@ def run(args: argparse.Namespace) -> int:
         print(f"{result.verdict}, "
               f"{result.iterations} iterations, {result.seconds:.2f} s, RMS residual "
               f"{result.rms_residual:.4g} N")
+        for i, e in enumerate(result.problem.experiments):
+            fig = result.noise_figure(i)
+            if fig is not None and len(result.problem.channels(i)) == 1:
+                print(f"  {e.case.test.id}: noise figure {fig.describe('N')}; residual "
+                      f"{result.residual_over_noise(i):.2f} times the noise")
         for i, (n, v, u) in enumerate(zip(result.names, result.values, result.units)):
             print(f"  {n:30s} {v:.6g} {u} {result.uncertainty_text(i)}")
         for c in result.confounded():

@@ -11,19 +11,22 @@ import numpy as np
 from scipy import signal
 from scipy.stats import chi2
 
-from ..data.signals import drive_frequency, find_spectral_peaks, welch_spectrum
+from ..data.signals import drive_frequency, find_spectral_peaks
 from ..fitting.result import FitResult
 
 __all__ = ["Evidence", "ResidualPeak", "SegmentDamping", "Trend", "amplitude_trend",
-           "collect_evidence", "noise_floor"]
+           "collect_evidence"]
 
 #: Residual peaks weaker than this fraction of the force amplitude are ignored.
 PEAK_FLOOR = 0.003
 #: Relative tolerance for calling a frequency a harmonic of the drive.
 HARMONIC_TOL = 0.03
-#: A residual this many times the measurement noise is within the noise: the white level
-#: read above the signal band may miss some coloured noise inside it, and the level itself
-#: scatters by a few per cent between records.
+#: A residual this many times the measurement noise is within the noise. Correct models
+#: leave 0.99-1.06 times the noise figure on the reference simulator's records (sines below,
+#: at and above resonance, amplitude steps, chirps up and down, a full-size tank; five noise
+#: draws each) and 0.86-1.16 on transport moves whose figure comes from a short rest before
+#: the move (0.84 s at 100 Hz: the figure's own sampling error): see
+#: estimate.fitting.noise_figures.
 NOISE_MARGIN = 1.15
 
 
@@ -129,12 +132,18 @@ class Evidence:
     segments: tuple[SegmentDamping, ...] = field(default=())
     #: Multi-channel cases: each channel's share of the scaled residual power (sums to 1).
     channel_share: dict[str, float] = field(default_factory=dict)
-    #: The residual over the measurement noise: the square root of the fit's residual
-    #: variance when its residuals are divided by their noise levels (estimated input),
-    #: else the RMS residual over the noise in the fitted band.
+    #: The residual over the measurement noise: ``rms_residual / noise_rms``, the fit's noise
+    #: figure (:meth:`~estimate.fitting.result.FitResult.residual_over_noise`).
     noise_ratio: float = math.nan
     #: Where the residual concentrates: frequencies (Hz) of its strongest spectral peaks.
     residual_frequencies: tuple[float, ...] = ()
+
+    def against(self, noise: float) -> "Evidence":
+        """This evidence measured against the noise figure ``noise`` (N, or channel scales):
+        a diagnosis states every fit of a record against one figure, its final model's."""
+        if not math.isfinite(noise) or noise <= 0 or self.channel_share:
+            return self
+        return replace(self, noise_rms=noise, noise_ratio=self.rms_residual / noise)
 
     @property
     def within_noise(self) -> bool:
@@ -175,17 +184,14 @@ class Evidence:
         return tuple(p for p in self.peaks if p.harmonic == 0)
 
 
-def noise_floor(time: np.ndarray, force: np.ndarray, cutoff_hz: float | None) -> float:
-    """RMS of white measurement noise inside the fitted band (N), from the raw force's PSD
-    between 1.5 and 4 times the cutoff (median, so tones do not count)."""
-    fs = 1.0 / float(np.median(np.diff(time)))
-    cut = cutoff_hz if cutoff_hz is not None else 0.2 * fs
-    spec = welch_spectrum(time, force)
-    band = (spec.frequency >= 1.5 * cut) & (spec.frequency <= min(4.0 * cut, 0.45 * fs))
-    if not np.any(band):
-        band = spec.frequency >= 0.6 * (fs / 2)
-    level = float(np.median(spec.psd[band]))
-    return math.sqrt(level * min(cut, fs / 2))
+def _noise(result: FitResult, case: int) -> tuple[float, float]:
+    """The noise figure of the fitted force of ``case`` (N) and the residual over it
+    (:meth:`~estimate.fitting.result.FitResult.residual_over_noise`): the one place the
+    diagnosis reads the noise."""
+    figure = result.noise_figure(case)
+    if figure is None:
+        return math.nan, math.nan
+    return figure.std, result.residual_over_noise(case)
 
 
 def _ljung_box(r: np.ndarray, lags: int = 20) -> tuple[float, float]:
@@ -256,10 +262,9 @@ def collect_evidence(result: FitResult, *, case: int = 0, segments: tuple[Segmen
         ratio = fhat[0] / f_pred
     pinned = tuple(wn.split("`")[1] for wn in result.warnings if "at its bound" in wn)
     rms = float(np.sqrt(np.mean(res[keep] ** 2)))
-    noise = noise_floor(t, exp.case.force, problem.force_cutoff_hz)
-    weighted = bool(problem.noise) and problem.noise[case] is not None
-    noise_ratio = (math.sqrt(result.residual_variance) if weighted
-                   else rms / max(noise, 1e-300))
+    # the fit's noise figure (estimate.fitting.noise_figures), one per record and channel;
+    # the ratio is these two numbers' quotient
+    noise, noise_ratio = _noise(result, case)
     return Evidence(
         rms_residual=rms, noise_rms=noise,
         drive_frequency=drive, sweep=sweep, peaks=tuple(peaks), harmonics=harmonics,
@@ -279,15 +284,16 @@ def _multichannel_evidence(result: FitResult, case: int) -> Evidence:
     r = result.scaled_residuals(case)[keep]
     power = np.sum(r**2, axis=0)
     total = float(power.sum()) or 1.0
-    noise = [noise_floor(t, np.asarray(exp.case.channels[c], float), problem.force_cutoff_hz) / scales[c]
-             for c in chans]
+    figs = result.noise_figures[case] if result.noise_figures else {}
+    noise = [figs[c].std / scales[c] if c in figs else math.nan for c in chans]
     q, pval = _ljung_box(r[:, int(np.argmax(power))])
     pinned = tuple(wn.split("`")[1] for wn in result.warnings if "at its bound" in wn)
     return Evidence(
         rms_residual=float(np.sqrt(np.mean(r**2))), noise_rms=float(np.sqrt(np.mean(np.square(noise)))),
         drive_frequency=None, sweep=False, peaks=(), harmonics={}, ljung_box_q=q,
         ljung_box_p=pval, skew_correlation=0.0, skew_delay=0.0, frequency_ratio=None,
-        pinned=pinned, channel_share={c: float(p / total) for c, p in zip(chans, power)})
+        pinned=pinned, channel_share={c: float(p / total) for c, p in zip(chans, power)},
+        noise_ratio=result.residual_over_noise(case))
 
 
 def segment_damping(result: FitResult, *, case: int = 0, n_segments: int = 4,

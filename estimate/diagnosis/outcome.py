@@ -69,16 +69,20 @@ class Verdict:
            findings: tuple[Finding, ...]) -> "Verdict":
         ratio = evidence.noise_ratio if math.isfinite(evidence.noise_ratio) else \
             evidence.rms_residual / max(evidence.noise_rms, 1e-300)
+        unit = "" if evidence.channel_share else " N"
+        numbers = (f" ({evidence.rms_residual:.4g}{unit} RMS over the noise figure "
+                   f"{evidence.noise_rms:.4g}{unit})" if math.isfinite(evidence.noise_rms) else "")
         if evidence.within_noise:
             model = "The extended analog" if findings else "The baseline analog"
             return cls(True, ratio, f"{model} explains the data: the residual is {ratio:.2f} "
-                                    f"times the measurement noise (within {NOISE_MARGIN:.2f}).")
+                                    f"times the measurement noise{numbers} (within "
+                                    f"{NOISE_MARGIN:.2f}).")
         where = [f"{f:.3g} Hz" for f in evidence.residual_frequencies]
         tried = [o for rnd in rounds for o in rnd if o.rejected is not None
                  and not o.rejected.startswith("not tried")]
         tried.sort(key=lambda o: -(o.gain if math.isfinite(o.gain) else -1.0))
         rejected = tuple(f"{o.cause} ({o.rejected})" for o in tried[:3])
-        text = (f"Unexplained: the residual is {ratio:.2f} times the measurement noise "
+        text = (f"Unexplained: the residual is {ratio:.2f} times the measurement noise{numbers} "
                 f"(more than {NOISE_MARGIN:.2f})"
                 + (f", concentrated at {', '.join(where)}" if where else "")
                 + ("; best rejected candidates: " + "; ".join(rejected) if rejected

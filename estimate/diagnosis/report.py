@@ -86,8 +86,7 @@ def summary(d: Diagnosis) -> str:
                              f"{c.bic_change:+.0f} | {verdict} |")
     lines += ["", "## Final parameters", ""] + _parameter_rows(d.final)
     lines += ["", f"{d.candidate_fits} fits in {d.seconds:.1f} s. Held-out RMS: 3 of 10 interleaved "
-              "blocks left out of every fit. Standard errors assume independent residuals "
-              "(optimistic for filtered data).", ""]
+              f"blocks left out of every fit. {d.final.interval_note()}", ""]
     lines += [f"Note: {n}" for n in d.notes]
     return "\n".join(lines) + "\n"
 

@@ -296,7 +296,9 @@ def _diagnose(cases, max_bic_change: float, max_rounds: int, segments: int,
     notes += _bound_notes("final model", final)
     final_evidence = collect_evidence(final, segments=evidence.segments)
     verdict = Verdict.of(final_evidence, tuple(rounds), tuple(findings))
-    return Diagnosis(base, base_evidence, tuple(findings), final, final_evidence,
+    # one noise figure per record: the final model's, the residual nearest the noise
+    return Diagnosis(base, base_evidence.against(final_evidence.noise_rms), tuple(findings),
+                     final, final_evidence,
                      tuple(rounds), fitter.count, time.perf_counter() - t0, tuple(notes),
                      verdict)
 

@@ -11,23 +11,27 @@ measurements support together.
 
 The knots are uniform, spaced ``1 / (12 f_top)`` with ``f_top`` the highest significant
 frequency of the carriage motion (:func:`estimate.data.signals.motion_band`, or the case's
-``[test] motion_band_hz``; at least one sample, at most 50 ms - also the spacing of a
-carriage at rest, whose displacement holds nothing above its noise): a quintic spline then
-represents the carriage acceleration to ~2e-4 of its amplitude. The noise band starts
-above the carriage motion's frequencies, or, when the carriage stands still, above the
-force's own (a free decay's force rings at the slosh frequency). Both
-noise levels are estimated from the spectra above the signal band
-(:func:`estimate.data.signals.noise_level`; the displacement's from the start spline's
-misfit instead when that is clearly larger: noise that is not white, as a displacement
-integrated from an accelerometer has, :data:`COLOURED_FACTOR`);
-a record that starts quiet starts with the carriage at rest (zero velocity and
-acceleration at the first sample).
+``[test] motion_band_hz``; at least one sample, at most :data:`MAX_SPACING` - also the
+spacing of a carriage at rest, whose displacement holds nothing above its noise): a quintic
+spline then represents the carriage acceleration to ~2e-4 of its amplitude. The noise band
+starts above the carriage motion's frequencies, or, when the carriage stands still, above
+the force's own (a free decay's force rings at the slosh frequency). The force residuals
+are weighed by the force's noise figure (:mod:`estimate.data.signals.noise_figure`): read
+from the record's quiet segments (the rest before the drive, a settled end) when it has
+them, else provisionally from the white level above the signal band, and then from the
+fit's residual (:mod:`estimate.fitting.noise_figures`). The displacement noise is its white
+level above the signal band (:func:`estimate.data.signals.noise_level`), or its quiet
+segments' level when that is larger (a low-passed displacement sensor), or the start
+spline's misfit when that is clearly larger still: noise that is not white, as a
+displacement integrated from an accelerometer has, :data:`COLOURED_FACTOR`. A record that
+starts quiet starts with the carriage at rest (zero velocity and acceleration at the first
+sample).
 """
 
 from __future__ import annotations
 
 import hashlib
-from dataclasses import dataclass, field
+from dataclasses import dataclass, field, replace
 
 import numpy as np
 import scipy.sparse as sps
@@ -43,14 +47,21 @@ from ..data.signals import (
     significant_frequencies,
     starts_quiet,
 )
+from ..data.signals.noise_figure import NoiseFigure, quiet_segments, segment_noise
 
 __all__ = ["CarriageSpline", "CarriageInput", "SplineExcitation", "RecordNoise",
-           "carriage_input", "record_noise"]
+           "carriage_input", "noise_band", "record_noise"]
 
 #: Knots per period of the highest significant carriage frequency.
-KNOTS_PER_PERIOD = 12
-#: Largest knot spacing [s]: slow drives still get a spline that follows start-up transients.
-MAX_SPACING = 0.05
+KNOTS_PER_PERIOD = 6
+#: Largest knot spacing [s], also of the knots where the carriage rests (before and after a
+#: transport move): there the spline has nothing to follow but would absorb force noise.
+MAX_SPACING = 0.25
+#: The carriage rests while its displacement stays within this many noise standard
+#: deviations of its first (last) value; the knots are dense from MOTION_MARGIN s before it
+#: leaves rest to MOTION_MARGIN s after it comes back (the force sees a smooth start first).
+REST_SIGMAS = 6.0
+MOTION_MARGIN = 0.3
 #: The noise band starts this factor above the highest significant carriage frequency, and
 #: never below NOISE_BAND_MIN_HZ (the slosh modes and their harmonics live below).
 NOISE_BAND_FACTOR = 3.0
@@ -82,9 +93,33 @@ class CarriageSpline:
         knots[degree], knots[m + degree] = t0, t1  # exact ends: no round-off outside
         return cls(knots, degree)
 
+    @classmethod
+    def graded(cls, t0: float, t1: float, spacing: float, moving: tuple[float, float],
+               rest_spacing: float, degree: int = 5) -> "CarriageSpline":
+        """Knots ``spacing`` apart while the carriage moves (``moving``, s) and at most
+        ``rest_spacing`` apart where it rests, the spacing growing by at most half from one
+        knot to the next; a knot on each end of ``[t0, t1]``."""
+        a, b = max(moving[0], t0), min(moving[1], t1)
+        if b - a >= t1 - t0 - 2 * spacing or rest_spacing <= spacing:
+            return cls.covering(t0, t1, spacing, degree)
+        inner = a + (b - a) * np.arange(max(int(np.ceil((b - a) / spacing)), 1) + 1) \
+            / max(int(np.ceil((b - a) / spacing)), 1)
+        right = _grown(b, t1, spacing, rest_spacing)
+        left = a - (_grown(0.0, a - t0, spacing, rest_spacing))[::-1]
+        inside = np.unique(np.r_[t0, left, inner, right, t1])
+        inside = inside[(inside >= t0) & (inside <= t1)]
+        keep = np.r_[True, np.diff(inside) > 0.5 * spacing]  # no knots closer than that
+        inside = inside[keep]
+        inside[-1] = t1
+        h0, h1 = inside[1] - inside[0], inside[-1] - inside[-2]
+        knots = np.r_[t0 - h0 * np.arange(degree, 0, -1), inside,
+                      t1 + h1 * np.arange(1, degree + 1)]
+        return cls(knots, degree)
+
     @property
     def spacing(self) -> float:
-        return float(self.knots[1] - self.knots[0])
+        """The smallest knot spacing (s)."""
+        return float(np.min(np.diff(self.knots)))
 
     @property
     def n_coefficients(self) -> int:
@@ -93,15 +128,17 @@ class CarriageSpline:
     def design(self, times: np.ndarray, derivative: int = 0) -> sps.csr_matrix:
         """``(len(times), n_coefficients)`` matrix mapping coefficients to the spline's
         ``derivative``-th time derivative at ``times`` (m, m/s, m/s^2)."""
-        k, d = self.degree, derivative
-        basis = BSpline.design_matrix(np.asarray(times, float), self.knots[d:self.knots.size - d],
-                                      k - d)
+        k, d, tau = self.degree, derivative, self.knots
+        basis = BSpline.design_matrix(np.asarray(times, float), tau[d:tau.size - d], k - d)
         D = sps.identity(self.n_coefficients, format="csr")
         for j in range(d):
             m = self.n_coefficients - j
-            # derivative of a uniform B-spline: differences of the coefficients / spacing
-            Dj = sps.diags([-np.ones(m - 1), np.ones(m - 1)], [0, 1], shape=(m - 1, m))
-            D = (Dj / self.spacing) @ D
+            # the derivative of a B-spline of degree q on knots tau is one of degree q - 1 on
+            # tau[1:-1] with coefficients q (c[i+1] - c[i]) / (tau[i+q+1] - tau[i+1])
+            q, knots = k - j, tau[j:tau.size - j]
+            scale = q / (knots[q + 1:q + m] - knots[1:m])
+            Dj = sps.diags([-scale, scale], [0, 1], shape=(m - 1, m))
+            D = Dj @ D
         return (basis @ D).tocsr()
 
     def inputs_matrix(self, times: np.ndarray) -> sps.csr_matrix:
@@ -112,6 +149,20 @@ class CarriageSpline:
         order = np.arange(3 * n).reshape(3, n).T.ravel()  # interleave x, xd, xdd per time
         return sps.vstack(blocks, format="csr")[order]
 
+
+
+def _grown(start: float, stop: float, spacing: float, largest: float) -> np.ndarray:
+    """Knots from ``start`` towards ``stop`` (excluded unless reached), the spacing growing
+    from ``spacing`` by half a step at a time up to ``largest``; the last interval stretched
+    or merged so that ``stop`` is a knot."""
+    out, h, x = [], spacing, start
+    while x + h < stop - 1e-12:
+        h = min(1.5 * h, largest)
+        x += h
+        out.append(x)
+    if out and stop - out[-1] < 0.5 * h:
+        out.pop()
+    return np.array(out + [stop])
 
 
 @dataclass(frozen=True)
@@ -131,8 +182,8 @@ class CarriageInput:
     coefficients : numpy.ndarray
         Start values (m): the least-squares spline through the measured displacement.
     displacement_noise : float
-        Standard deviation of the white noise on the recorded displacement (m), estimated
-        from its spectrum above the signal band.
+        Standard deviation of the noise on the recorded displacement (m): its white level
+        above the signal band, or its quiet segments' level when larger.
     displacement : numpy.ndarray
         The recorded displacement without tones above the signal band (m), as fitted.
     displacement_tones : tuple of (float, float)
@@ -257,31 +308,67 @@ class RecordNoise:
     Attributes
     ----------
     force_noise : float
-        Standard deviation of the white noise on the recorded force (N), from its spectrum
-        above ``band_hz``; the force residuals are divided by it.
+        The force noise (N) the force residuals are divided by: ``figure.std``.
     force : numpy.ndarray
         The recorded force without the tones above ``band_hz`` (N).
     tones : tuple of (float, float)
         The tones removed: frequency (Hz) and amplitude (N).
     band_hz : float
-        Lower edge of the band above the mechanics (Hz) where noise and tones were read.
+        Lower edge of the band above the mechanics (Hz) where tones were read.
+    figure : NoiseFigure
+        The force's noise figure as known before the fit: from quiet segments
+        (``source == "quiet"``), else the white level above ``band_hz`` (``"spectrum"``,
+        provisional: the fit reads the figure from its residual,
+        :mod:`estimate.fitting.noise_figures`), or a residual's figure when a fit was
+        re-weighed by it (``"residual"``).
+    quiet : tuple of (int, int)
+        Index ranges of the record's quiet segments.
     """
 
     force_noise: float
     force: np.ndarray = field(repr=False)
     tones: tuple[tuple[float, float], ...]
     band_hz: float
+    figure: NoiseFigure | None = None
+    quiet: tuple[tuple[int, int], ...] = ()
+
+    def weighed_by(self, figure: NoiseFigure) -> "RecordNoise":
+        """A copy whose force residuals are divided by ``figure``."""
+        return replace(self, force_noise=float(figure.std), figure=figure)
 
 
-def record_noise(time: np.ndarray, force: np.ndarray, top_frequency: float) -> RecordNoise:
-    """Noise level and tones of a recorded force (N) whose mechanics reach up to
-    ``top_frequency`` (Hz): both read above ``max(3 top_frequency, 12 Hz)``."""
-    band = max(NOISE_BAND_FACTOR * top_frequency, NOISE_BAND_MIN_HZ)
+def noise_band(top_frequency: float) -> float:
+    """Lower edge [Hz] of the band above mechanics reaching up to ``top_frequency`` [Hz]."""
+    return max(NOISE_BAND_FACTOR * top_frequency, NOISE_BAND_MIN_HZ)
+
+
+def record_noise(time: np.ndarray, force: np.ndarray, top_frequency: float, *,
+                 quiet: tuple[tuple[int, int], ...] = ()) -> RecordNoise:
+    """Noise figure and tones of a recorded force (N) whose mechanics reach up to
+    ``top_frequency`` (Hz): tones read above ``max(3 top_frequency, 12 Hz)``; the figure from
+    the ``quiet`` segments (index ranges) when there are any, else provisionally the white
+    level above that band."""
+    band = noise_band(top_frequency)
     F = np.asarray(force, float)
     clean, tones = remove_tones(time, F, above_hz=band)
-    level = max(noise_level(time, clean, above_hz=band),
-                NOISE_FLOOR * float(np.sqrt(np.mean(F**2))))
-    return RecordNoise(level, clean, tones, band)
+    floor = NOISE_FLOOR * float(np.sqrt(np.mean(F**2)))
+    if quiet:
+        figure = segment_noise(time, clean, quiet, detail=_quiet_text(time, quiet))
+    else:
+        figure = NoiseFigure(noise_level(time, clean, above_hz=band), "spectrum", (),
+                             float(time[-1] - time[0]),
+                             f"white level above {band:.3g} Hz, provisional")
+    if figure.std < floor:
+        figure = replace(figure, std=floor)
+    return RecordNoise(figure.std, clean, tones, band, figure, tuple(quiet))
+
+
+def _quiet_text(time: np.ndarray, quiet: tuple[tuple[int, int], ...]) -> str:
+    names = []
+    for a, b in quiet:
+        what = "rest before the drive" if a == 0 else "settled end"
+        names.append(f"{what} {time[a]:.3g}-{time[b - 1]:.3g} s")
+    return "quiet segments: " + ", ".join(names)
 
 
 def carriage_input(time: np.ndarray, displacement: np.ndarray, *,
@@ -313,6 +400,15 @@ _RECENT: dict = {}
 _RECENT_SIZE = 4
 
 
+def adopt_noise(old: RecordNoise, new: RecordNoise) -> None:
+    """Keep ``new`` in place of ``old`` among the kept :func:`carriage_input` results: later
+    problems built on the same record are weighed by ``new`` at once (a figure read from a
+    fit's residual, :func:`estimate.fitting.noise_figures.reweighed`)."""
+    for key, (ci, rn) in list(_RECENT.items()):
+        if rn is old:
+            _RECENT[key] = (ci, new)
+
+
 def forget_records() -> None:
     """Drop the kept :func:`carriage_input` results (benchmarks time a first fit of a
     record with it)."""
@@ -333,12 +429,21 @@ def _carriage_input(time: np.ndarray, displacement: np.ndarray, force: np.ndarra
                     default=0.0)
     else:
         f_top = f_motion
-    noise = record_noise(t, force, f_top)
-    x_clean, x_tones = remove_tones(t, x, above_hz=noise.band_hz)
-    sx = max(noise_level(t, x_clean, above_hz=noise.band_hz), NOISE_FLOOR * float(np.std(x)))
+    band = noise_band(f_top)
+    x_clean, x_tones = remove_tones(t, x, above_hz=band)
+    sx = max(noise_level(t, x_clean, above_hz=band), NOISE_FLOOR * float(np.std(x)))
+    F_clean, _ = remove_tones(t, np.asarray(force, float), above_hz=band)
+    quiet = quiet_segments(t, x_clean, F_clean, displacement_noise=sx, band_hz=band,
+                           starts_at_rest=at_rest)
+    noise = record_noise(t, force, f_top, quiet=quiet)
+    if quiet:
+        sx = max(sx, segment_noise(t, x_clean, quiet).std)
     if at_rest is None:
         at_rest = starts_quiet(t, x_clean, sx) and starts_quiet(t, noise.force, noise.force_noise)
-    spline = CarriageSpline.covering(float(t[0]), float(t[-1]), spacing)
+    spline = CarriageSpline.graded(float(t[0]), float(t[-1]), spacing,
+                                   _moving(t, x_clean, REST_SIGMAS * sx,
+                                           1.0 / f_top if f_top > 0 else MAX_SPACING),
+                                   MAX_SPACING)
     basis = _rest_basis(spline, float(t[0])) if at_rest else None
     B = spline.design(t) if basis is None else (spline.design(t) @ basis).tocsr()
     coefficients = _least_squares(B, x_clean)
@@ -363,6 +468,19 @@ def _misfit(B: sps.spmatrix, coefficients: np.ndarray, x: np.ndarray) -> float:
     freedom: samples less coefficients)."""
     r = x - B @ coefficients
     return float(np.sqrt(r @ r / max(x.size - B.shape[1], 1)))
+
+
+def _moving(t: np.ndarray, x: np.ndarray, tolerance: float, period: float
+            ) -> tuple[float, float]:
+    """The span (s) in which the carriage moves: from a margin before the displacement ``x``
+    (m) first leaves ``tolerance`` of its first value to a margin after it last leaves
+    that of its final one; the margin is :data:`MOTION_MARGIN` s, at least ``period``."""
+    away = np.flatnonzero(np.abs(x - np.median(x[:10])) > tolerance)
+    back = np.flatnonzero(np.abs(x - np.median(x[-10:])) > tolerance)
+    if away.size == 0 or back.size == 0:
+        return float(t[0]), float(t[-1])
+    margin = max(MOTION_MARGIN, period)
+    return float(t[away[0]] - margin), float(t[back[-1]] + margin)
 
 
 def _least_squares(B: sps.spmatrix, x: np.ndarray) -> np.ndarray:

@@ -13,7 +13,7 @@ import math
 import sys
 import time
 from collections.abc import Mapping
-from dataclasses import dataclass
+from dataclasses import dataclass, replace
 from functools import cached_property
 
 import casadi as ca
@@ -27,6 +27,7 @@ from ..interrupts import surfacing
 from ._progress import Recorder, progress_printer
 from ._sparse import scipy_csc
 from .covariance import reduced_jacobian, uncertainty
+from .noise_figures import case_figures, reweighed
 from .problem import FitProblem
 from .result import FitResult, derived_quantities
 from .terms import CaseTerms, case_terms
@@ -204,9 +205,16 @@ def fit(problem: FitProblem, *, transcription: Transcription = MultipleShooting(
                      *(np.asarray(out[j]).ravel() for j in (0, 2, 3)), J, Je, Jg, t_start,
                      transcription, cost, carriage, xres, states, coefs, tuple(kinds),
                      initial_states)
+    again = reweighed(problem, result.noise_figures)  # a provisional force weight was off
+    if again is not None:
+        second = fit(again.with_initial(dict(zip(result.names, result.values))),
+                     transcription=transcription, hessian=hessian, cost=cost,
+                     initial_state=initial_state, solver_options=solver_options,
+                     progress=progress, robust_start=False, compile_=compile_,
+                     warm_start=result, balance=balance)
+        return replace(second, iterations=result.iterations + second.iterations,
+                       seconds=time.perf_counter() - t_start)
     if balance and cost == "squared":
-        from dataclasses import replace
-
         from .balance import rebalanced
 
         again = rebalanced(result)
@@ -214,11 +222,12 @@ def fit(problem: FitProblem, *, transcription: Transcription = MultipleShooting(
             balanced, text = again
             balanced = replace(balanced.with_initial(dict(zip(result.names, result.values))),
                                notes=balanced.notes + (text,))
-            result = fit(balanced, transcription=transcription, hessian=hessian, cost=cost,
+            second = fit(balanced, transcription=transcription, hessian=hessian, cost=cost,
                          initial_state=initial_state, solver_options=solver_options,
                          progress=progress, robust_start=False, compile_=compile_,
                          warm_start=result, balance=False)
-            result = replace(result, seconds=time.perf_counter() - t_start)
+            result = replace(second, iterations=result.iterations + second.iterations,
+                             seconds=time.perf_counter() - t_start)
     return result
 
 
@@ -403,9 +412,13 @@ def _result(problem: FitProblem, theta: np.ndarray, stats: dict, recorder: Recor
     n_force = int(sum(np.count_nonzero(w) * c for w, c in zip(weights, nch)))
     n_disp = sum(x.size for x in displacement_residuals if x is not None)
     at_bound = tuple(_at_bound(x, v) for x, v in zip(problem.estimated, theta))
+    # the scores of the robust covariance are read from the measured channels' rows
+    samples = [np.r_[np.tile(np.arange(np.shape(m)[0]), c),
+                     np.full(0 if x is None else x.size, -1)]
+               for m, c, x in zip(measured, nch, displacement_residuals)]
     unc = uncertainty(Je, Jg, e, n_force + n_disp, theta.size,
                       np.array([x.scale for x in problem.estimated]), problem.names,
-                      held=tuple(i for i, side in enumerate(at_bound) if side))
+                      held=tuple(i for i, side in enumerate(at_bound) if side), samples=samples)
     active = tuple(b for b in problem.linear_bounds if _on_linear_bound(b, problem, theta))
     if active:
         unc = _held_on(unc, np.array([b.row(problem.names) for b in active]))
@@ -433,14 +446,22 @@ def _result(problem: FitProblem, theta: np.ndarray, stats: dict, recorder: Recor
                         f"{r_squared:.3g}): the record may hold noise only, a channel of "
                         "another quantity, or a drive that does not excite the model; check it "
                         "before using these estimates")
-    derived, derived_units = derived_quantities(problem, theta, unc.covariance,
-                                                np.array([side is None for side in at_bound]))
+    # the intervals use the robust covariance: the Gauss-Newton one when the residuals are
+    # white, wider when they are correlated (coloured noise, a filtered force, a model that
+    # misses a small effect), where the Gauss-Newton one is optimistic
+    kind = "robust" if unc.robust is not None else "gauss-newton"
+    cov = unc.robust if unc.robust is not None else unc.covariance
+    free = np.array([side is None for side in at_bound])
+    stderr = np.where(free, np.sqrt(np.clip(np.diag(cov), 0, None)), np.nan)
+    derived, derived_units = derived_quantities(problem, theta, cov, free)
     pieces = np.split(raw, np.cumsum([int(np.size(m)) for m in measured])[:-1])
     residuals = tuple(p if np.ndim(m) == 1 else p.reshape(m.shape, order="F")
                       for p, m in zip(pieces, measured))
+    figures = tuple(case_figures(problem, i, r, w)
+                    for i, (r, w) in enumerate(zip(residuals, weights)))
     return FitResult(
         problem=problem,
-        values=theta, stderr=unc.stderr, covariance=unc.covariance,
+        values=theta, stderr=stderr, covariance=cov,
         cost=ssr, rms_residual=math.sqrt(ssr / n_force),
         r_squared=r_squared,
         n_samples=n_force, iterations=int(stats.get("iter_count", len(recorder.costs))),
@@ -461,7 +482,9 @@ def _result(problem: FitProblem, theta: np.ndarray, stats: dict, recorder: Recor
         dof=max(n_force + n_disp - (Je.shape[1] - Jg.shape[0]), 1),
         initial_state_kinds=initial_state_kinds, initial_states=initial_states,
         at_bound=at_bound, bound_stderr=unc.bound_stderr,
-        active_bounds=tuple(b.text for b in active),
+        active_bounds=tuple(b.text for b in active), noise_figures=figures,
+        gauss_newton_covariance=unc.covariance, robust_covariance=unc.robust,
+        covariance_kind=kind, bandwidths=unc.bandwidths,
     )
 
 
@@ -488,15 +511,22 @@ def _on_linear_bound(bound, problem: FitProblem, theta: np.ndarray) -> bool:
 
 
 def _held_on(unc, rows: np.ndarray):
-    """``unc`` with its covariance conditioned on the active linear bounds ``rows``
+    """``unc`` with its covariances (Gauss-Newton and robust) conditioned on the active
+    linear bounds ``rows``
     (:func:`estimate.fitting.budget.conditioned`), standard errors and correlations anew."""
     from dataclasses import replace
 
     from .budget import conditioned
 
     free = np.isfinite(unc.stderr)
-    cov = np.zeros_like(unc.covariance)
-    cov[np.ix_(free, free)] = conditioned(unc.covariance[np.ix_(free, free)], rows[:, free])
+
+    def held(c):
+        out = np.zeros_like(c)
+        out[np.ix_(free, free)] = conditioned(c[np.ix_(free, free)], rows[:, free])
+        return out
+
+    cov = held(unc.covariance)
+    robust = None if unc.robust is None else held(unc.robust)
     se = np.full(free.size, np.nan)
     se[free] = np.sqrt(np.clip(np.diag(cov)[free], 0, None))
     corr = np.full_like(cov, np.nan)
@@ -504,7 +534,7 @@ def _held_on(unc, rows: np.ndarray):
         sub = cov[np.ix_(free, free)] / np.outer(se[free], se[free])
     corr[np.ix_(free, free)] = np.clip(np.nan_to_num(sub, nan=0.0, posinf=0.0, neginf=0.0),
                                        -1.0, 1.0)
-    return replace(unc, covariance=cov, stderr=se, correlation=corr)
+    return replace(unc, covariance=cov, stderr=se, correlation=corr, robust=robust)
 
 
 def _at_bound(x, value: float) -> str | None:

@@ -38,19 +38,16 @@ def drive_frequency_of(result: "FitResult", case: int = 0) -> float | None:
 
 
 def noise_density(result: "FitResult", channel: str, case: int = 0) -> float | None:
-    """White-noise amplitude density of the raw ``channel`` [N/sqrt(Hz) or N m/sqrt(Hz)],
-    seen above the fitted band (1.5 times the force cutoff)."""
-    from ..data.signals import noise_level
-
-    exp = result.problem.experiments[case]
-    raw = exp.case.channels.get(channel)
-    if raw is None:
+    """Amplitude density of the ``channel``'s noise figure
+    (:meth:`~estimate.fitting.result.FitResult.noise_figure`) spread evenly to Nyquist
+    [N/sqrt(Hz) or N m/sqrt(Hz)]: the level of a white noise of the figure's standard
+    deviation."""
+    fig = result.noise_figure(case, channel) if result.noise_figures else None
+    if fig is None or not fig.std > 0:
         return None
-    t = np.asarray(exp.case.time, float)
+    t = np.asarray(result.problem.experiments[case].case.time, float)
     fs = 1.0 / float(np.median(np.diff(t)))
-    cut = result.problem.force_cutoff_hz or 0.2 * fs
-    s = noise_level(t, raw, above_hz=1.5 * cut)
-    return float(s * np.sqrt(2.0 / fs)) if s > 0 else None
+    return float(fig.std * np.sqrt(2.0 / fs))
 
 
 def spectrum_top(fs: float, cutoff_hz: float | None, marked: list[float]) -> float:
@@ -140,9 +137,16 @@ def _spectrum_panel(ax, result, case, t, items, unit: str, drive: float | None,
         floor = noise_density(result, name, case)
         if floor is not None:
             floors.append(floor)
+            if len(items) == 1:  # the figure's coloured spectrum
+                fig = result.noise_figure(case, name)
+                f = sp.frequency[band]
+                ax.semilogy(f, np.sqrt(fig.psd(f, fs)), gid="noise floor", **style.NOISE,
+                            label=f"noise figure {fig.std:.3g} {unit} ({fig.source})")
     if floors:
         floor = float(np.median(floors))
-        ax.axhline(floor, label="noise floor (raw data)", gid="noise floor", **style.NOISE)
+        if len(items) > 1:
+            ax.axhline(floor, label="noise figures (white equivalent)", gid="noise floor",
+                       **style.NOISE)
     else:
         floor = None
     if drive is not None and drive < top_f:

@@ -560,9 +560,10 @@ def _noise_notes(exps, carriage, noise) -> tuple[str, ...]:
         if rn is None:
             continue
         cid = e.case.test.id
-        text = (f"{cid}: force noise {rn.force_noise:.3g} N"
-                + (f", displacement noise {ci.displacement_noise:.3g} m" if ci else "")
-                + f" (white levels above {rn.band_hz:.3g} Hz)")
+        fig = rn.figure
+        text = (f"{cid}: force residuals weighed by the force noise {rn.force_noise:.3g} N ("
+                + (fig.detail if fig is not None else "") + ")"
+                + (f", displacement residuals by {ci.displacement_noise:.3g} m" if ci else ""))
         if ci is not None:
             text += (f"; carriage motion estimated (quintic spline, knots "
                      f"{1e3 * ci.spline.spacing:.3g} ms apart"

@@ -12,12 +12,16 @@ import numpy as np
 from analogs.errors import InputError, UnknownNameError
 
 if TYPE_CHECKING:  # pragma: no cover
+    from ..data.signals.noise_figure import NoiseFigure
     from .identifiability import Identifiability
     from .problem import FitProblem
 
 __all__ = ["FitResult", "derived_quantities"]
 
 _PROFILE_HINT = "`profile_interval` gives a profile-likelihood interval of a chosen parameter."
+#: The fit report calls the Gauss-Newton standard error of an estimate optimistic when the
+#: robust one exceeds it by more than this factor.
+OPTIMISTIC_FACTOR = 1.5
 
 
 def derived_quantities(problem: "FitProblem", theta: np.ndarray, cov: np.ndarray,
@@ -48,6 +52,11 @@ def derived_quantities(problem: "FitProblem", theta: np.ndarray, cov: np.ndarray
         se[np.any(J[:, ~np.asarray(free, bool)] != 0, axis=1)] = np.nan
     values = {k: (float(a), float(b)) for k, a, b in zip(found, v, se)}
     return values, {k: unit for k, (_, unit) in found.items()}
+
+
+def _json_number(x: float) -> float | None:
+    """NaN is written as null."""
+    return float(x) if math.isfinite(x) else None
 
 
 def _json_bound(x: float) -> float | None:
@@ -132,6 +141,19 @@ class FitResult:
     #: The linear bounds the estimates end on (the masses within the liquid,
     #: :mod:`estimate.fitting.budget`), in words; the covariance holds them there.
     active_bounds: tuple[str, ...] = ()
+    #: Per case, the noise figure of each fitted channel
+    #: (:mod:`estimate.fitting.noise_figures`): the one figure the report, the covariance,
+    #: the diagnosis verdict and the campaign use.
+    noise_figures: tuple[dict[str, "NoiseFigure"], ...] = field(default=(), repr=False)
+    #: Both covariances of the estimates (:mod:`estimate.fitting.covariance`): Gauss-Newton
+    #: (independent residuals) and robust to autocorrelated residuals (Newey-West sandwich);
+    #: ``covariance`` and ``stderr`` are the one named by ``covariance_kind``, which the
+    #: intervals use.
+    gauss_newton_covariance: np.ndarray | None = field(default=None, repr=False)
+    robust_covariance: np.ndarray | None = field(default=None, repr=False)
+    covariance_kind: str = "gauss-newton"
+    #: Per case, the Newey-West bandwidth of the robust covariance (samples).
+    bandwidths: tuple[int, ...] = ()
 
     @property
     def bounds_reached(self) -> tuple[str, ...]:
@@ -168,6 +190,20 @@ class FitResult:
             cov = np.nan_to_num(self.covariance)
             out[t.parameter] = (t.value(by_label), float(np.sqrt(max(c @ cov @ c, 0.0))), t.text)
         return out
+
+    def noise_figure(self, case: int = 0, channel: str | None = None) -> "NoiseFigure | None":
+        """The noise figure of ``channel`` (default: the first fitted) of ``case``."""
+        figures = self.noise_figures[case] if self.noise_figures else {}
+        if not figures:
+            return None
+        return figures[channel] if channel is not None else next(iter(figures.values()))
+
+    def residual_over_noise(self, case: int = 0) -> float:
+        """The RMS residual on the fitted samples of ``case`` over its noise figure
+        (:func:`estimate.fitting.noise_figures.residual_over_noise`)."""
+        from .noise_figures import residual_over_noise
+
+        return residual_over_noise(self, case)
 
     def scaled_residuals(self, case: int = 0) -> np.ndarray:
         """Residuals of ``case`` divided by their channel scales (what the cost sums):
@@ -308,32 +344,102 @@ class FitResult:
             out.append(text)
         return out
 
+    @property
+    def gauss_newton_stderr(self) -> np.ndarray:
+        """Standard errors from the Gauss-Newton covariance (independent residuals; NaN at a
+        bound)."""
+        return self._stderr(self.gauss_newton_covariance)
+
+    @property
+    def robust_stderr(self) -> np.ndarray:
+        """Standard errors from the covariance robust to autocorrelated residuals (NaN at a
+        bound, or when it was not computed)."""
+        return self._stderr(self.robust_covariance)
+
+    def _stderr(self, cov: np.ndarray | None) -> np.ndarray:
+        if cov is None:
+            return np.full(len(self.names), np.nan)
+        se = np.sqrt(np.clip(np.diag(cov), 0, None))
+        return np.where(np.array(self.free, bool), se, np.nan)
+
+    def optimistic(self, factor: float = OPTIMISTIC_FACTOR) -> dict[str, float]:
+        """Estimates whose robust standard error exceeds the Gauss-Newton one by more than
+        ``factor``, with the ratio: there the residuals are correlated (coloured noise, a
+        filtered force, or an effect the model lacks) and the Gauss-Newton intervals are
+        optimistic."""
+        gn, rb = self.gauss_newton_stderr, self.robust_stderr
+        with np.errstate(invalid="ignore", divide="ignore"):
+            ratio = rb / gn
+        return {n: float(r) for n, r in zip(self.names, ratio) if np.isfinite(r) and r > factor}
+
+    def interval_note(self) -> str:
+        """One sentence: which covariance the standard errors come from, and where the
+        Gauss-Newton ones are optimistic."""
+        if self.covariance_kind != "robust":
+            return "Standard errors: Gauss-Newton covariance (independent residuals)."
+        worse = self.optimistic()
+        return ("Standard errors: the covariance robust to correlated residuals (Newey-West); "
+                + ("the Gauss-Newton ones, which assume independent residuals, are optimistic: "
+                   + ", ".join(f"{r:.2g}x smaller for `{n}`" for n, r in worse.items()) + "."
+                   if worse else f"the Gauss-Newton ones agree within {OPTIMISTIC_FACTOR:g}x."))
+
     def covariance_note(self) -> str:
-        """Which covariance the standard errors come from, and what it assumes."""
+        """Which covariance the standard errors and intervals come from, and why."""
         p = self.problem
-        if p.force_cutoff_hz is not None:
-            return ("Standard errors: Gauss-Newton covariance scaled by the residual variance. "
-                    f"The force was low-passed at {p.force_cutoff_hz:g} Hz, so its residuals "
-                    "are autocorrelated and the standard errors are optimistic; the input "
-                    "was treated as exact. " + _PROFILE_HINT)
-        text = ("Standard errors: Gauss-Newton covariance of the whole NLP (states "
-                "eliminated through the dynamics")
+        text = ("Standard errors and intervals: the covariance robust to correlated residuals "
+                "(a sandwich whose middle is the Newey-West long-run covariance of the "
+                "parameters' scores" if self.covariance_kind == "robust" else
+                "Standard errors and intervals: the Gauss-Newton covariance (independent "
+                "residuals")
+        text += ("; beside it the Gauss-Newton covariance of the whole NLP, states "
+                 "eliminated through the dynamics" if self.covariance_kind == "robust" else "")
         if p.input == "estimated" and any(c is not None for c in p.carriage):
-            text += ("; force and displacement residuals divided by their white-noise levels, "
-                     "the carriage motion estimated and marginalised")
-        text += (f"), scaled by the residual variance {self.residual_variance:.3g} "
-                 f"({self.dof} degrees of freedom). The force is not filtered, so the "
-                 "residuals are close to independent. " + _PROFILE_HINT)
-        return text
+            text += ("; force and displacement residuals divided by their noise figures, the "
+                     "carriage motion estimated and marginalised")
+        text += (f"; scaled by the residual variance {self.residual_variance:.3g}, "
+                 f"{self.dof} degrees of freedom). ")
+        if p.force_cutoff_hz is not None:
+            text += (f"The force was low-passed at {p.force_cutoff_hz:g} Hz, which correlates "
+                     "neighbouring residuals, and the input was treated as exact. ")
+        if self.covariance_kind == "robust":
+            text += ("The robust one is used because it equals the Gauss-Newton one when the "
+                     "residuals are white and widens when they are not (coloured transducer "
+                     "noise, a filtered force, an effect the model lacks), where the "
+                     "Gauss-Newton one is optimistic. ")
+            worse = self.optimistic()
+            if worse:
+                text += ("Here the Gauss-Newton standard errors are optimistic: the robust ones "
+                         "are " + ", ".join(f"{r:.2g}x for `{n}`" for n, r in worse.items())
+                         + ". ")
+        return text + _PROFILE_HINT
+
+    def _noise_lines(self) -> list[str]:
+        """The noise figure of every fitted channel and the residual over it."""
+        out = []
+        many = len(self.noise_figures) > 1
+        for i, figs in enumerate(self.noise_figures):
+            cid = f"{self.problem.experiments[i].case.test.id}: " if many else ""
+            for c, fig in figs.items():
+                unit = "N m" if c.startswith("torque") else "N"
+                label = c if len(figs) > 1 else "force"
+                out.append(f"    noise figure       = {cid}{label} {fig.describe(unit)}")
+            ratio = self.residual_over_noise(i)
+            if math.isfinite(ratio):
+                out.append(f"    residual / noise   = {cid}{ratio:.3f} (RMS residual on the fitted "
+                           "samples over the noise figure)")
+        return out
 
     # -- output ------------------------------------------------------------------------------
     def to_dict(self) -> dict[str, Any]:
         """The fixed-key JSON form written by ``slosh fit``."""
         params: dict[str, Any] = {}
         free = self.free
+        gn_se, rb_se = self.gauss_newton_stderr, self.robust_stderr
         for i, (name, v, se, e) in enumerate(zip(self.names, self.values, self.stderr,
                                                  self.problem.estimated)):
             params[name] = {"value": float(v), "stderr": float(se) if free[i] else None,
+                            "stderr_gauss_newton": _json_number(gn_se[i]),
+                            "stderr_robust": _json_number(rb_se[i]),
                             "unit": e.unit, "lower": _json_bound(e.lower),
                             "upper": _json_bound(e.upper), "estimated": True}
             if not free[i]:
@@ -382,7 +488,15 @@ class FitResult:
             "input": self.problem.input,
             "covariance_note": self.covariance_note(),
             "notes": list(self.problem.notes),
+            "covariance_kind": self.covariance_kind,
+            "covariance_gauss_newton": None if self.gauss_newton_covariance is None else
+            self.gauss_newton_covariance[np.ix_(free, free)].tolist(),
+            "newey_west_lags": list(self.bandwidths),
             "residual_variance": self.residual_variance,
+            "noise_figures": [{c: f.to_dict() for c, f in figs.items()}
+                              for figs in self.noise_figures],
+            "residual_over_noise": [_json_number(self.residual_over_noise(i))
+                                    for i in range(len(self.noise_figures))],
             "noise": [_noise_dict(ci, rn) for ci, rn in zip(
                 self.problem.carriage or [None] * len(self.problem.experiments),
                 self.problem.noise or [None] * len(self.problem.experiments))],
@@ -403,8 +517,11 @@ class FitResult:
                  f"    variables          = {len(self.names)}",
                  f"    cost (sum r^2)     = {self.cost:.6g} {'N^2' if single else '(scaled)'}",
                  f"    RMS residual       = {self.rms_residual:.6g} {'N' if single else '(scaled)'}",
-                 f"    R^2                = {self.r_squared:.6f}",
-                 "[[Variables]]"]
+                 f"    R^2                = {self.r_squared:.6f}"]
+        lines += self._noise_lines()
+        lines.append("[[Variables]] (95 % intervals from the "
+                     f"{'robust' if self.covariance_kind == 'robust' else 'Gauss-Newton'} "
+                     "covariance; GN: the Gauss-Newton standard error)")
         for i, (name, v, se, e) in enumerate(zip(self.names, self.values, self.stderr,
                                                  self.problem.estimated)):
             if not self.free[i]:
@@ -413,8 +530,10 @@ class FitResult:
                 continue
             rel = f"({abs(se / v) * 100:.2f}%)" if v else ""
             lo, hi = self.interval(name)
-            lines.append(f"    {name:28s} = {v:.6g} +/- {se:.3g} {rel:10s} {e.unit:12s} "
-                         f"95%: [{lo:.6g}, {hi:.6g}]  (init {e.initial:.4g})")
+            gn = self.gauss_newton_stderr[i]
+            gn_text = f"  GN +/- {gn:.3g}" if self.covariance_kind == "robust" else ""
+            lines.append(f"    {name:28s} = {v:.6g} {f'+/- {se:.3g}':13s} {rel:10s} {e.unit:12s} "
+                         f"95%: [{lo:.6g}, {hi:.6g}]{gn_text}  (init {e.initial:.4g})")
         for name, (v, se, text) in self.tied().items():
             lines.append(f"    {name:28s} = {v:.6g} +/- {se:.3g} (follows: {text})")
         if self.derived:

@@ -11,6 +11,9 @@ modify their inputs.
   than 0.1% on a 20-30 s record.
 * :func:`check_drive_frequency` - the seed's data check: the dominant force frequency must match
   the drive frequency within 1.5%.
+* :class:`NoiseFigure`, :func:`quiet_segments`, :func:`segment_noise`,
+  :func:`residual_noise` - the noise of a channel inside the signal band, from quiet segments
+  or a fit's residual (:mod:`.noise_figure`).
 * :func:`displacement_derivatives` - carriage position, velocity and acceleration from a measured
   noisy displacement with no phase lag and controlled noise amplification.
 
@@ -30,6 +33,7 @@ samples then carry an error of order 10% of that component's amplitude.
 from .derivatives import displacement_derivatives, motion_band, significant_frequencies
 from .filters import lowpass
 from .noise import noise_level, remove_tones, starts_quiet
+from .noise_figure import NoiseFigure, quiet_segments, residual_noise, segment_noise
 from .spectra import (
                       DriveCheck,
                       Peak,
@@ -43,6 +47,7 @@ from .spectra import (
 
 __all__ = [
     "DriveCheck",
+    "NoiseFigure",
     "Peak",
     "Spectrum",
     "check_drive_frequency",
@@ -51,9 +56,12 @@ __all__ = [
     "drive_frequency",
     "find_spectral_peaks",
     "lowpass",
-    "noise_level",
-    "remove_tones",
     "motion_band",
+    "noise_level",
+    "quiet_segments",
+    "remove_tones",
+    "residual_noise",
+    "segment_noise",
     "significant_frequencies",
     "starts_quiet",
     "welch_spectrum",

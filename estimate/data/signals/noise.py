@@ -53,6 +53,23 @@ def noise_level(time: ArrayLike, values: ArrayLike, *, above_hz: float) -> float
     return float(np.sqrt(np.median(p[band]) * fs / 2))
 
 
+#: A tone's amplitude in each quarter of the record is at least this fraction of the largest.
+STEADY_RATIO = 0.5
+
+
+def _steady(t: np.ndarray, y: np.ndarray, frequency: float) -> bool:
+    """Whether the sinusoid at ``frequency`` has a steady amplitude over the quarters of the
+    record (offset, trend and the sinusoid fitted in each)."""
+    amps = []
+    for tq, yq in zip(np.array_split(t, 4), np.array_split(y, 4)):
+        tc = tq - tq.mean()
+        w = 2 * np.pi * frequency
+        A = np.column_stack([np.ones_like(tc), tc, np.cos(w * tc), np.sin(w * tc)])
+        coef, *_ = np.linalg.lstsq(A, yq, rcond=None)
+        amps.append(float(np.hypot(coef[2], coef[3])))
+    return min(amps) >= STEADY_RATIO * max(amps)
+
+
 def starts_quiet(time: ArrayLike, values: ArrayLike, noise: float, *,
                  seconds: float = 0.1, factor: float = 3.0) -> bool:
     """Whether the first ``seconds`` of ``values`` hold nothing but noise of standard
@@ -70,9 +87,12 @@ def remove_tones(time: ArrayLike, values: ArrayLike, *, above_hz: float,
     and the lines removed as ``(frequency Hz, amplitude)``.
 
     A line is a Welch peak above ``above_hz`` whose PSD exceeds ``prominence`` times the
-    median PSD of that band; its frequency is refined and all lines are fitted together
-    (offset, trend and one sinusoid each) and subtracted. Only the band above the signal is
-    searched, so nothing of the mechanics is removed.
+    median PSD of that band and whose amplitude is steady over the record (each quarter's
+    within a factor :data:`STEADY_RATIO` of the largest: a burst, such as a transport move's
+    force or a servo's ripple while moving, is no tone, and a sinusoid fitted across the
+    whole record would add it where it is absent); its frequency is refined and all lines
+    are fitted together (offset, trend and one sinusoid each) and subtracted. Only the band
+    above the signal is searched, so nothing of the mechanics is removed.
     """
     t, y, step = _as_uniform(time, values, "values")
     fs = 1.0 / step
@@ -90,6 +110,9 @@ def remove_tones(time: ArrayLike, values: ArrayLike, *, above_hz: float,
     if idx.size == 0:
         return y.copy(), ()
     freqs = [_refine_frequency(t, y, float(f[i]), fs / nper) for i in idx]
+    freqs = [fk for fk in freqs if _steady(t, y, fk)]
+    if not freqs:
+        return y.copy(), ()
     tc = t - t.mean()
     cols = [np.ones_like(tc), tc]
     for fk in freqs:
