@@ -11,20 +11,17 @@ import numpy as np
 from scipy import signal
 from scipy.stats import chi2
 
-from ..data.signals import drive_frequency, find_spectral_peaks, welch_spectrum
+from ..data.signals import drive_frequency, find_spectral_peaks
 from ..fitting.result import FitResult
+from .scoring import NoiseFigure, noise_figure
 
 __all__ = ["Evidence", "ResidualPeak", "SegmentDamping", "Trend", "amplitude_trend",
-           "collect_evidence", "noise_floor"]
+           "collect_evidence"]
 
 #: Residual peaks weaker than this fraction of the force amplitude are ignored.
 PEAK_FLOOR = 0.003
 #: Relative tolerance for calling a frequency a harmonic of the drive.
 HARMONIC_TOL = 0.03
-#: A residual this many times the measurement noise is within the noise: the white level
-#: read above the signal band may miss some coloured noise inside it, and the level itself
-#: scatters by a few per cent between records.
-NOISE_MARGIN = 1.15
 
 
 @dataclass(frozen=True)
@@ -112,10 +109,12 @@ def amplitude_trend(segments: tuple[SegmentDamping, ...], quantity: str) -> Tren
 
 @dataclass(frozen=True)
 class Evidence:
-    """Numbers describing a fit's residual (see the module docstring)."""
+    """Numbers describing a fit's residual (see the module docstring): ``rms_residual`` on
+    the fitted samples (N, or channel scales) and ``noise``, the residual over the
+    measurement noise (:func:`~estimate.diagnosis.scoring.noise_figure`)."""
 
     rms_residual: float
-    noise_rms: float
+    noise: NoiseFigure
     drive_frequency: float | None
     sweep: bool
     peaks: tuple[ResidualPeak, ...]
@@ -129,19 +128,23 @@ class Evidence:
     segments: tuple[SegmentDamping, ...] = field(default=())
     #: Multi-channel cases: each channel's share of the scaled residual power (sums to 1).
     channel_share: dict[str, float] = field(default_factory=dict)
-    #: The residual over the measurement noise: the square root of the fit's residual
-    #: variance when its residuals are divided by their noise levels (estimated input),
-    #: else the RMS residual over the noise in the fitted band.
-    noise_ratio: float = math.nan
     #: Where the residual concentrates: frequencies (Hz) of its strongest spectral peaks.
     residual_frequencies: tuple[float, ...] = ()
 
     @property
+    def noise_rms(self) -> float:
+        """The measurement noise the residual is compared with (:attr:`noise`)."""
+        return self.noise.noise
+
+    @property
+    def noise_ratio(self) -> float:
+        """The residual over the measurement noise (:attr:`noise`)."""
+        return self.noise.ratio
+
+    @property
     def within_noise(self) -> bool:
-        """The residual is within :data:`NOISE_MARGIN` of the measurement noise."""
-        ratio = self.noise_ratio if math.isfinite(self.noise_ratio) else \
-            self.rms_residual / max(self.noise_rms, 1e-300)
-        return ratio <= NOISE_MARGIN
+        """The residual is within the noise (:attr:`noise`)."""
+        return self.noise.within
 
     @property
     def damping_trend(self) -> Trend | None:
@@ -173,19 +176,6 @@ class Evidence:
     def unexplained_peaks(self) -> tuple[ResidualPeak, ...]:
         """Peaks that are not drive harmonics, strongest first."""
         return tuple(p for p in self.peaks if p.harmonic == 0)
-
-
-def noise_floor(time: np.ndarray, force: np.ndarray, cutoff_hz: float | None) -> float:
-    """RMS of white measurement noise inside the fitted band (N), from the raw force's PSD
-    between 1.5 and 4 times the cutoff (median, so tones do not count)."""
-    fs = 1.0 / float(np.median(np.diff(time)))
-    cut = cutoff_hz if cutoff_hz is not None else 0.2 * fs
-    spec = welch_spectrum(time, force)
-    band = (spec.frequency >= 1.5 * cut) & (spec.frequency <= min(4.0 * cut, 0.45 * fs))
-    if not np.any(band):
-        band = spec.frequency >= 0.6 * (fs / 2)
-    level = float(np.median(spec.psd[band]))
-    return math.sqrt(level * min(cut, fs / 2))
 
 
 def _ljung_box(r: np.ndarray, lags: int = 20) -> tuple[float, float]:
@@ -256,15 +246,11 @@ def collect_evidence(result: FitResult, *, case: int = 0, segments: tuple[Segmen
         ratio = fhat[0] / f_pred
     pinned = tuple(wn.split("`")[1] for wn in result.warnings if "at its bound" in wn)
     rms = float(np.sqrt(np.mean(res[keep] ** 2)))
-    noise = noise_floor(t, exp.case.force, problem.force_cutoff_hz)
-    weighted = bool(problem.noise) and problem.noise[case] is not None
-    noise_ratio = (math.sqrt(result.residual_variance) if weighted
-                   else rms / max(noise, 1e-300))
     return Evidence(
-        rms_residual=rms, noise_rms=noise,
+        rms_residual=rms, noise=noise_figure(result, case),
         drive_frequency=drive, sweep=sweep, peaks=tuple(peaks), harmonics=harmonics,
         ljung_box_q=q, ljung_box_p=pval, skew_correlation=corr, skew_delay=delay,
-        frequency_ratio=ratio, pinned=pinned, segments=segments, noise_ratio=noise_ratio,
+        frequency_ratio=ratio, pinned=pinned, segments=segments,
         residual_frequencies=tuple(p.frequency for p in peaks[:3]))
 
 
@@ -273,18 +259,15 @@ def _multichannel_evidence(result: FitResult, case: int) -> Evidence:
     exp = problem.experiments[case]
     t = np.asarray(exp.case.time, float)
     chans = result.channels[case]
-    scales = result.channel_scales[case]
     w = result.weights[case] if result.weights else np.ones(t.size)
     keep = w > 0
     r = result.scaled_residuals(case)[keep]
     power = np.sum(r**2, axis=0)
     total = float(power.sum()) or 1.0
-    noise = [noise_floor(t, np.asarray(exp.case.channels[c], float), problem.force_cutoff_hz) / scales[c]
-             for c in chans]
     q, pval = _ljung_box(r[:, int(np.argmax(power))])
     pinned = tuple(wn.split("`")[1] for wn in result.warnings if "at its bound" in wn)
     return Evidence(
-        rms_residual=float(np.sqrt(np.mean(r**2))), noise_rms=float(np.sqrt(np.mean(np.square(noise)))),
+        rms_residual=float(np.sqrt(np.mean(r**2))), noise=noise_figure(result, case),
         drive_frequency=None, sweep=False, peaks=(), harmonics={}, ljung_box_q=q,
         ljung_box_p=pval, skew_correlation=0.0, skew_delay=0.0, frequency_ratio=None,
         pinned=pinned, channel_share={c: float(p / total) for c, p in zip(chans, power)})
