@@ -81,6 +81,9 @@ class Record:
     prediction: Prediction | None = None
     duration: float = 30.0
     displacement_noise: float = 2e-5
+    #: a known failure: why the diagnosis does not name it yet (the recall test expects
+    #: the failure, strictly: a fix shows up as an unexpected pass)
+    known: str = ""
 
 
 TONE = ref.Tone(0.05, 25.0)
@@ -155,9 +158,19 @@ RECORDS: dict[str, Record] = {
                             seed=117, prediction=PRED60),
     "sweep60_delay": Record("sensor delay 30 ms", SWEEP60_4HZ, (P60,), ("sensor_delay",),
                             seed=118, prediction=PRED60, effects={"tone": TONE, "sensor_delay": 0.03}),
-    "sine80_delay": Record("sensor delay 20 ms", R(ref.Sine(0.0006, 2.4), 1.5, 0.0), (M1_80,),
-                           ("sensor_delay",), fill=0.8, fixed_mass=FIXED80 + 0.066, seed=119,
-                           effects={"tone": TONE, "sensor_delay": 0.02}),
+    # (a 20 ms delay on a 2.4 Hz sine at 80 % fill is not named either: at one frequency a
+    # delay is a phase the pendulum's damping and frequency imitate; unexplained at 1.63 x)
+    "chirp80_delay": Record("sensor delay 20 ms", CHIRP_03MM, (M1_80,), ("sensor_delay",),
+                            fill=0.8, fixed_mass=FIXED80 + 0.066, seed=119,
+                            displacement_noise=1e-5,
+                            effects={"tone": TONE, "sensor_delay": 0.02},
+                            known="the delay's fit reaches the noise on the fitted samples "
+                                  "(objective 1.47e5 -> 3497) but its held-out chi-square "
+                                  "rises by 5e5 (held-out RMS +31 %): rejected"),
+    "steps60_rigfriction": Record("rig friction 2 N s/m + 0.1 N", STEPS60, (P60,),
+                                  ("rig_friction",), {"rig.friction_viscous": 2.0}, seed=127,
+                                  prediction=PRED60,
+                                  effects={"tone": TONE, "friction": ref.Friction(0.1, 2.0)}),
     "sweep60_offset": Record("force offset 0.5 N + drift 0.01 N/s", SWEEP60, (P60,),
                              ("sensor_offset",), {"rig.force_offset": 0.5}, seed=120,
                              prediction=PRED60, effects={"tone": TONE, "offset": 0.5, "drift": 0.01}),
@@ -169,10 +182,16 @@ RECORDS: dict[str, Record] = {
                                   ("rig_friction",), {"rig.friction_viscous": 2.0}, seed=122,
                                   prediction=PRED60,
                                   effects={"tone": TONE, "friction": ref.Friction(0.1, 2.0)}),
-    "sine80_rigfriction": Record("rig friction 1 N s/m + 0.05 N", R(ref.Sine(0.001, 2.2), 1.5, 0.0),
-                                 (M1_80,), ("rig_friction",), {"rig.friction_viscous": 1.0},
-                                 fill=0.8, fixed_mass=FIXED80 + 0.066, seed=123,
-                                 effects={"tone": TONE, "friction": ref.Friction(0.05, 1.0)}),
+    # (rig friction of 1 N s/m + 0.05 N under a 2.2 Hz sine at 80 % fill was not named:
+    # at one frequency a force in phase with the velocity is what the hinge damper near
+    # resonance gives; unexplained at 1.27 x)
+    "chirp80_rigfriction": Record("rig friction 1 N s/m + 0.05 N", CHIRP_03MM, (M1_80,),
+                                  ("rig_friction",), {"rig.friction_viscous": 1.0}, fill=0.8,
+                                  fixed_mass=FIXED80 + 0.066, seed=123, displacement_noise=1e-5,
+                                  effects={"tone": TONE, "friction": ref.Friction(0.05, 1.0)},
+                                  known="named sensor_delay + slosh_mode (1.56 x the noise): the "
+                                        "Coulomb part's square wave in a 0.3 mm chirp reads as a "
+                                        "phase lag; rig_friction screened with a negative sign"),
     "steps60_asymmetric": Record("asymmetric hinge spring 0.13 th^2", STEPS60,
                                  (ref.Pendulum(P60.mass, P60.length, 0.0, P60.damping,
                                                extra=lambda th, thd: 0.13 * th**2),),

@@ -384,9 +384,9 @@ def _try(fitter: Fitter, prop: Proposal, current: FitResult,
         text = prop.describe(res)
     except (KeyError, ValueError, StopIteration):
         text = prop.cause
-    return CandidateOutcome(prop.cause, prop.added, rms0, res, reason, text,
-                            prop.score if math.isfinite(prop.score) else None,
-                            rms1, gain, dbic, chi0 - chi1)
+    return CandidateOutcome(prop.cause, prop.added, rms0, res, rejected=reason, evidence=text,
+                            score=prop.score if math.isfinite(prop.score) else None,
+                            rms_after=rms1, gain=gain, bic_change=dbic, heldout_chi2=chi0 - chi1)
 
 
 def _finding(best: CandidateOutcome, others: list[CandidateOutcome]) -> Finding:

@@ -63,7 +63,9 @@ def check(row: dict) -> None:
 
 
 @pytest.mark.slow
-@pytest.mark.parametrize("name", list(R.RECORDS))
+@pytest.mark.parametrize("name", [
+    pytest.param(n, marks=pytest.mark.xfail(strict=True, reason=r.known) if r.known else ())
+    for n, r in R.RECORDS.items()])
 def test_recall(name, tmp_path):
     check(run(name, tmp_path))
 
@@ -77,6 +79,8 @@ def _table(rows: list[dict]) -> str:
             ok = "yes"
         except AssertionError as err:
             ok = f"NO: {str(err).splitlines()[0][:80]}"
+        if R.RECORDS[r["record"]].known:
+            ok += " (known failure)"
         params = "; ".join(f"`{k}` {v:.4g} ({100 * (v / t - 1):+.1f} %)"
                            for k, (v, t) in r["parameters"].items()) or "-"
         out.append(f"| {r['record']} | {r['effect']} | {', '.join(r['named']) or 'none'} | "
