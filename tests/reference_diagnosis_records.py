@@ -167,9 +167,11 @@ RECORDS: dict[str, Record] = {
                             known="the delay's fit reaches the noise on the fitted samples "
                                   "(objective 1.47e5 -> 3497) but its held-out chi-square "
                                   "rises by 5e5 (held-out RMS +31 %): rejected"),
+    # one drive frequency: the viscous and Coulomb parts, both in phase with the velocity,
+    # trade (the tolerance is 20 %)
     "steps60_rigfriction": Record("rig friction 2 N s/m + 0.1 N", STEPS60, (P60,),
                                   ("rig_friction",), {"rig.friction_viscous": 2.0}, seed=127,
-                                  prediction=PRED60,
+                                  prediction=PRED60, tolerance=0.2,
                                   effects={"tone": TONE, "friction": ref.Friction(0.1, 2.0)}),
     "sweep60_offset": Record("force offset 0.5 N + drift 0.01 N/s", SWEEP60, (P60,),
                              ("sensor_offset",), {"rig.force_offset": 0.5}, seed=120,

@@ -162,8 +162,14 @@ def before_after_figure(d: Diagnosis, path: str | Path | None = None):
     t = np.asarray(d.baseline.problem.experiments[0].case.time, float)
     meas = d.baseline.measured[0]
     base, final = d.baseline.simulated(0), d.final.simulated(0)
+    # the baseline's simulation in its held-out blocks follows a carriage motion read off
+    # the displacement alone: shaded and left blank, as in its residual panel
+    held_base = (d.baseline.weights[0] == 0) if d.baseline.weights else np.zeros(t.size, bool)
+    base = np.where(held_base, np.nan, base)
     fig = style.figure(path, figsize=(10, 8.5))
     ax = fig.subplots(3, 1, sharex=True, height_ratios=[2.2, 1, 1])
+    for lo, hi in _runs(t, held_base):
+        ax[0].axvspan(lo, hi, color="#fee08b", alpha=0.5, lw=0, zorder=0)
     ax[0].plot(t, meas, **style.MEASURED, label=_measured_label(d.baseline))
     base_style = {**style.SIMULATED, "color": "#e08214", "ls": (0, (2, 1.5))}
     final_style = {**style.SIMULATED, "ls": "-"}

@@ -5,6 +5,8 @@ pendulum's frequency): a rotor of 0.01 kg m^2 coupled at 4 1/s is found by the m
 and its fit recovers inertia and damping; on the same record without the rotor the scan
 explains little and the rotor's fit is not accepted.
 
+Slow suite: a six-channel spinning-rig fit takes minutes, not seconds.
+
 Tolerance: 15 % on inertia and damping (a 10 s record; the full 20 s record of the slow
 test is held to 10 %)."""
 
@@ -27,6 +29,7 @@ def _case(tmp_path, rotor):
                               duration=10.0)[0]
 
 
+@pytest.mark.slow  # six-channel spinning-rig fits take minutes
 def test_rotor_is_scanned_and_recovered(tmp_path):
     run = run_family(_case(tmp_path, ROTOR), "rotor")
     assert run.proposed and run.proposals[0].added == ("r1",)
@@ -36,6 +39,7 @@ def test_rotor_is_scanned_and_recovered(tmp_path):
     assert fit.value("r1.damping") == pytest.approx(ROTOR.damping, rel=0.15)
 
 
+@pytest.mark.slow  # six-channel spinning-rig fits take minutes
 def test_rotor_is_not_accepted_without_one(tmp_path):
     from estimate.diagnosis.scoring import bic, heldout
 
