@@ -12,12 +12,14 @@ __all__ = ["add_parser"]
 
 
 def add_parser(sub: argparse._SubParsersAction) -> None:
+    from ..diagnosis.families import CAUSES
+
     p = sub.add_parser(
         "diagnose", help="find what the baseline analog misses, name the cause, extend the model",
         description="Fit the baseline analog (fixed mass + first-mode pendulum, no hinge spring), "
-                    "collect the residual evidence, try candidate extensions (slosh mode, "
-                    "quadratic damping, diaphragm stiffness, sensor delay, rig friction) and "
-                    "accept those that cut the held-out residual significantly.")
+                    "collect the residual evidence, try the candidate families "
+                    f"({', '.join(CAUSES)}) and accept those that cut the held-out residual "
+                    "significantly.")
     p.add_argument("cases", nargs="+", help="test case files (TOML)")
     p.add_argument("--json", dest="json_out", required=True, help="write the diagnosis as JSON")
     p.add_argument("--report", default=None, help="write the report folder (plots, Markdown)")
@@ -51,5 +53,5 @@ def run(args: argparse.Namespace) -> int:
         if args.report:
             write_report(d, paths["--report"], overwrite=True)
     text = summary(d)
-    print(text.split("## What the baseline gets wrong")[0].strip())
+    print(text.split("## The baseline's residual")[0].strip())
     return 0

@@ -13,6 +13,7 @@ from scipy.stats import chi2
 
 from ..data.signals import drive_frequency, find_spectral_peaks
 from ..fitting.result import FitResult
+from .scoring import ResidualOverNoise, noise_figure
 
 __all__ = ["Evidence", "ResidualPeak", "SegmentDamping", "Trend", "amplitude_trend",
            "collect_evidence"]
@@ -21,13 +22,6 @@ __all__ = ["Evidence", "ResidualPeak", "SegmentDamping", "Trend", "amplitude_tre
 PEAK_FLOOR = 0.003
 #: Relative tolerance for calling a frequency a harmonic of the drive.
 HARMONIC_TOL = 0.03
-#: A residual this many times the measurement noise is within the noise. Correct models
-#: leave 0.99-1.06 times the noise figure on the reference simulator's records (sines below,
-#: at and above resonance, amplitude steps, chirps up and down, a full-size tank; five noise
-#: draws each) and 0.86-1.16 on transport moves whose figure comes from a short rest before
-#: the move (0.84 s at 100 Hz: the figure's own sampling error): see
-#: estimate.fitting.noise_figures.
-NOISE_MARGIN = 1.15
 
 
 @dataclass(frozen=True)
@@ -115,10 +109,12 @@ def amplitude_trend(segments: tuple[SegmentDamping, ...], quantity: str) -> Tren
 
 @dataclass(frozen=True)
 class Evidence:
-    """Numbers describing a fit's residual (see the module docstring)."""
+    """Numbers describing a fit's residual (see the module docstring): ``rms_residual`` on
+    the fitted samples (N, or channel scales) and ``noise``, the residual over the
+    measurement noise (:func:`~estimate.diagnosis.scoring.noise_figure`)."""
 
     rms_residual: float
-    noise_rms: float
+    noise: ResidualOverNoise
     drive_frequency: float | None
     sweep: bool
     peaks: tuple[ResidualPeak, ...]
@@ -132,25 +128,32 @@ class Evidence:
     segments: tuple[SegmentDamping, ...] = field(default=())
     #: Multi-channel cases: each channel's share of the scaled residual power (sums to 1).
     channel_share: dict[str, float] = field(default_factory=dict)
-    #: The residual over the measurement noise: ``rms_residual / noise_rms``, the fit's noise
-    #: figure (:meth:`~estimate.fitting.result.FitResult.residual_over_noise`).
-    noise_ratio: float = math.nan
     #: Where the residual concentrates: frequencies (Hz) of its strongest spectral peaks.
     residual_frequencies: tuple[float, ...] = ()
 
-    def against(self, noise: float) -> "Evidence":
-        """This evidence measured against the noise figure ``noise`` (N, or channel scales):
-        a diagnosis states every fit of a record against one figure, its final model's."""
-        if not math.isfinite(noise) or noise <= 0 or self.channel_share:
-            return self
-        return replace(self, noise_rms=noise, noise_ratio=self.rms_residual / noise)
+    @property
+    def noise_rms(self) -> float:
+        """The measurement noise the residual is compared with (:attr:`noise`)."""
+        return self.noise.noise
+
+    @property
+    def noise_ratio(self) -> float:
+        """The residual over the measurement noise (:attr:`noise`)."""
+        return self.noise.ratio
 
     @property
     def within_noise(self) -> bool:
-        """The residual is within :data:`NOISE_MARGIN` of the measurement noise."""
-        ratio = self.noise_ratio if math.isfinite(self.noise_ratio) else \
-            self.rms_residual / max(self.noise_rms, 1e-300)
-        return ratio <= NOISE_MARGIN
+        """The residual is within the noise (:attr:`noise`)."""
+        return self.noise.within
+
+    def against(self, other: ResidualOverNoise) -> "Evidence":
+        """This evidence measured against the noise of ``other`` (another fit of the same
+        record, in the same unit): a diagnosis states every fit of a record against one
+        figure, its final model's (a wrong baseline's residual holds its error, and a figure
+        read from it would be too high)."""
+        if other.unit != self.noise.unit or not math.isfinite(other.noise) or other.noise <= 0:
+            return self
+        return replace(self, noise=replace(self.noise, noise=other.noise, how=other.how))
 
     @property
     def damping_trend(self) -> Trend | None:
@@ -182,16 +185,6 @@ class Evidence:
     def unexplained_peaks(self) -> tuple[ResidualPeak, ...]:
         """Peaks that are not drive harmonics, strongest first."""
         return tuple(p for p in self.peaks if p.harmonic == 0)
-
-
-def _noise(result: FitResult, case: int) -> tuple[float, float]:
-    """The noise figure of the fitted force of ``case`` (N) and the residual over it
-    (:meth:`~estimate.fitting.result.FitResult.residual_over_noise`): the one place the
-    diagnosis reads the noise."""
-    figure = result.noise_figure(case)
-    if figure is None:
-        return math.nan, math.nan
-    return figure.std, result.residual_over_noise(case)
 
 
 def _ljung_box(r: np.ndarray, lags: int = 20) -> tuple[float, float]:
@@ -262,14 +255,11 @@ def collect_evidence(result: FitResult, *, case: int = 0, segments: tuple[Segmen
         ratio = fhat[0] / f_pred
     pinned = tuple(wn.split("`")[1] for wn in result.warnings if "at its bound" in wn)
     rms = float(np.sqrt(np.mean(res[keep] ** 2)))
-    # the fit's noise figure (estimate.fitting.noise_figures), one per record and channel;
-    # the ratio is these two numbers' quotient
-    noise, noise_ratio = _noise(result, case)
     return Evidence(
-        rms_residual=rms, noise_rms=noise,
+        rms_residual=rms, noise=noise_figure(result, case),
         drive_frequency=drive, sweep=sweep, peaks=tuple(peaks), harmonics=harmonics,
         ljung_box_q=q, ljung_box_p=pval, skew_correlation=corr, skew_delay=delay,
-        frequency_ratio=ratio, pinned=pinned, segments=segments, noise_ratio=noise_ratio,
+        frequency_ratio=ratio, pinned=pinned, segments=segments,
         residual_frequencies=tuple(p.frequency for p in peaks[:3]))
 
 
@@ -278,22 +268,18 @@ def _multichannel_evidence(result: FitResult, case: int) -> Evidence:
     exp = problem.experiments[case]
     t = np.asarray(exp.case.time, float)
     chans = result.channels[case]
-    scales = result.channel_scales[case]
     w = result.weights[case] if result.weights else np.ones(t.size)
     keep = w > 0
     r = result.scaled_residuals(case)[keep]
     power = np.sum(r**2, axis=0)
     total = float(power.sum()) or 1.0
-    figs = result.noise_figures[case] if result.noise_figures else {}
-    noise = [figs[c].std / scales[c] if c in figs else math.nan for c in chans]
     q, pval = _ljung_box(r[:, int(np.argmax(power))])
     pinned = tuple(wn.split("`")[1] for wn in result.warnings if "at its bound" in wn)
     return Evidence(
-        rms_residual=float(np.sqrt(np.mean(r**2))), noise_rms=float(np.sqrt(np.mean(np.square(noise)))),
+        rms_residual=float(np.sqrt(np.mean(r**2))), noise=noise_figure(result, case),
         drive_frequency=None, sweep=False, peaks=(), harmonics={}, ljung_box_q=q,
         ljung_box_p=pval, skew_correlation=0.0, skew_delay=0.0, frequency_ratio=None,
-        pinned=pinned, channel_share={c: float(p / total) for c, p in zip(chans, power)},
-        noise_ratio=result.residual_over_noise(case))
+        pinned=pinned, channel_share={c: float(p / total) for c, p in zip(chans, power)})
 
 
 def segment_damping(result: FitResult, *, case: int = 0, n_segments: int = 4,

@@ -9,28 +9,45 @@ from typing import Any
 
 from ..fitting.measurement import SensorDelay
 from ..fitting.result import FitResult
-from .evidence import NOISE_MARGIN, Evidence
+from .evidence import Evidence
+from .fitter import FitRecord
+from .scoring import NOISE_MARGIN
 
 __all__ = ["CandidateOutcome", "Finding", "Verdict", "Diagnosis"]
 
 
 @dataclass(frozen=True)
 class CandidateOutcome:
-    """A candidate that was screened or refitted: held-out RMS before/after (N), gain, the
-    held-out chi-square reduction, BIC change, its score statistic, and why it was not
-    accepted (``None`` when it qualified)."""
+    """A candidate of a round: what it adds, the held-out RMS residual before it (N, or
+    channel scales), its score statistic (``None``: it has none), why it was not accepted
+    (``None`` when it qualified), its evidence in words, and the fit it ended with (the
+    current fit when it was not fitted). A fitted candidate also has the held-out RMS
+    after it, the gain (relative RMS reduction), the held-out chi-square reduction and the
+    BIC change; those are ``None`` for a candidate that was not fitted."""
 
     cause: str
     added: tuple[str, ...]
     rms_before: float
-    rms_after: float
-    gain: float
-    bic_change: float
-    rejected: str | None
-    evidence: str
     result: FitResult = field(repr=False)
-    heldout_chi2: float = math.nan
-    score: float = math.nan
+    rejected: str | None = None
+    evidence: str = ""
+    score: float | None = None
+    rms_after: float | None = None
+    gain: float | None = None
+    bic_change: float | None = None
+    heldout_chi2: float | None = None
+
+    @property
+    def fitted(self) -> bool:
+        """The candidate was fitted (it has a held-out gain)."""
+        return self.gain is not None
+
+    @classmethod
+    def not_fitted(cls, cause: str, added: tuple[str, ...], current: FitResult,
+                   rms_before: float, why: str, score: float | None = None) -> "CandidateOutcome":
+        """A candidate screened out or not tried, and why."""
+        return cls(cause, added, rms_before, current, rejected=why,
+                   score=None if score is None or not math.isfinite(score) else score)
 
 
 @dataclass(frozen=True)
@@ -40,6 +57,7 @@ class Finding:
     cause: str
     evidence: str
     added: tuple[str, ...]
+    #: held-out RMS residual before and after (N, or channel scales) and the relative gain
     rms_before: float
     rms_after: float
     gain: float
@@ -67,23 +85,21 @@ class Verdict:
     @classmethod
     def of(cls, evidence: Evidence, rounds: tuple[tuple[CandidateOutcome, ...], ...],
            findings: tuple[Finding, ...]) -> "Verdict":
-        ratio = evidence.noise_ratio if math.isfinite(evidence.noise_ratio) else \
-            evidence.rms_residual / max(evidence.noise_rms, 1e-300)
-        unit = "" if evidence.channel_share else " N"
-        numbers = (f" ({evidence.rms_residual:.4g}{unit} RMS over the noise figure "
-                   f"{evidence.noise_rms:.4g}{unit})" if math.isfinite(evidence.noise_rms) else "")
-        if evidence.within_noise:
+        noise = evidence.noise
+        ratio = noise.ratio
+        figure = (f"the residual ({noise.residual:.3g} {noise.unit}) is {ratio:.2f} times the "
+                  f"measurement noise ({noise.noise:.3g} {noise.unit})")
+        if noise.within:
             model = "The extended analog" if findings else "The baseline analog"
-            return cls(True, ratio, f"{model} explains the data: the residual is {ratio:.2f} "
-                                    f"times the measurement noise{numbers} (within "
-                                    f"{NOISE_MARGIN:.2f}).")
+            return cls(True, ratio, f"{model} explains the data: {figure}, within "
+                                    f"{NOISE_MARGIN:.2f}.")
         where = [f"{f:.3g} Hz" for f in evidence.residual_frequencies]
-        tried = [o for rnd in rounds for o in rnd if o.rejected is not None
-                 and not o.rejected.startswith("not tried")]
-        tried.sort(key=lambda o: -(o.gain if math.isfinite(o.gain) else -1.0))
+        tried = [o for rnd in rounds for o in rnd if o.rejected is not None and o.fitted]
+        tried += [o for rnd in rounds for o in rnd if o.rejected is not None and not o.fitted
+                  and o.rejected.startswith("screened")]
+        tried.sort(key=lambda o: -(o.gain if o.fitted else -1.0))
         rejected = tuple(f"{o.cause} ({o.rejected})" for o in tried[:3])
-        text = (f"Unexplained: the residual is {ratio:.2f} times the measurement noise{numbers} "
-                f"(more than {NOISE_MARGIN:.2f})"
+        text = (f"Unexplained: {figure}, more than {NOISE_MARGIN:.2f}"
                 + (f", concentrated at {', '.join(where)}" if where else "")
                 + ("; best rejected candidates: " + "; ".join(rejected) if rejected
                    else "; no candidate family or library term fits it")
@@ -93,7 +109,8 @@ class Verdict:
 
 @dataclass(frozen=True)
 class Diagnosis:
-    """The outcome of :func:`estimate.diagnose`."""
+    """The outcome of :func:`estimate.diagnose`: the baseline and final fits with their
+    evidence, the findings, every round's candidates, the fits made and the verdict."""
 
     baseline: FitResult
     baseline_evidence: Evidence
@@ -105,6 +122,13 @@ class Diagnosis:
     seconds: float
     notes: tuple[str, ...] = ()
     verdict: Verdict | None = None
+    #: every fit of the diagnosis with its purpose, time and the budget that ended it
+    fits: tuple[FitRecord, ...] = ()
+
+    @property
+    def budget_ended(self) -> tuple[FitRecord, ...]:
+        """The fits a budget (iterations or time) ended."""
+        return tuple(f for f in self.fits if f.ended_by)
 
     @property
     def unexplained(self) -> bool:
@@ -135,6 +159,9 @@ class Diagnosis:
                             for c in rnd] for rnd in self.rounds],
             "candidate_fits": self.candidate_fits,
             "seconds": self.seconds,
+            "fits": [{"purpose": f.purpose, "budget": f.budget, "iterations": f.iterations,
+                      "seconds": f.seconds, "status": f.status, "ended_by": f.ended_by}
+                     for f in self.fits],
             "notes": list(self.notes),
         }
 

@@ -21,6 +21,22 @@ REPORT_FILES = ("summary.md", "diagnosis.json", "fit_before_after.png", "residua
                 "parameters.md")
 
 
+def _filtered(res: FitResult) -> float | None:
+    """The force filter's cutoff (Hz) when the fit low-passed the measured force, else ``None``."""
+    return res.problem.force_cutoff_hz if res.problem.input == "filtered" else None
+
+
+def _measured_label(res: FitResult) -> str:
+    """What the plotted measured force is: as recorded, low-passed, or with the tones above
+    the mechanics removed (the estimated input's force)."""
+    cut = _filtered(res)
+    if cut:
+        return f"measured (low-passed at {cut:g} Hz)"
+    raw = res.problem.experiments[0].case.force
+    same = np.shape(res.measured[0]) == np.shape(raw) and np.array_equal(res.measured[0], raw)
+    return "measured" if same else "measured (tones above the mechanics removed)"
+
+
 def _parameter_rows(res: FitResult) -> list[str]:
     rows = ["| parameter | estimate | std. error | 95 % interval | unit |", "|---|---|---|---|---|"]
     for i, (name, v, se, e) in enumerate(zip(res.names, res.values, res.stderr,
@@ -29,14 +45,25 @@ def _parameter_rows(res: FitResult) -> list[str]:
         se_text = f"{se:.2g}" if res.free[i] else res.uncertainty_text(i)
         rows.append(f"| `{name}` | {v:.5g} | {se_text} | [{lo:.5g}, {hi:.5g}] | {e.unit} |")
     for k, (v, se) in res.derived.items():
-        rows.append(f"| `{k}` (derived) | {v:.5g} | {se:.2g} | | |" if se == se
-                    else f"| `{k}` (derived) | {v:.5g} | at a bound | | |")
+        unit = res.derived_units.get(k, "")
+        rows.append(f"| `{k}` (derived) | {v:.5g} | {se:.2g} | | {unit} |" if se == se
+                    else f"| `{k}` (derived) | {v:.5g} | at a bound | | {unit} |")
     return rows
 
 
+def _candidate_row(i: int, c, accepted: bool) -> str:
+    verdict = "accepted" if accepted else (c.rejected or "smaller gain")
+    if c.fitted:
+        return (f"| {i} | {c.cause} | {', '.join(c.added)} | {100 * c.gain:.1f} % | "
+                f"{c.bic_change:+.0f} | {verdict} |")
+    return f"| {i} | {c.cause} | {', '.join(c.added)} | not fitted | | {verdict} |"
+
+
 def summary(d: Diagnosis) -> str:
-    """Markdown summary: verdict, findings with evidence, what the baseline got wrong."""
+    """Markdown summary: verdict, findings with evidence, the baseline's residual, the
+    candidates, the final parameters and the fits (with the budgets that ended any)."""
     ev = d.baseline_evidence
+    cut = _filtered(d.baseline)
     lines = [f"# Diagnosis of {', '.join(e.case.test.id for e in d.baseline.problem.experiments)}", ""]
     if d.findings:
         lines.append(f"**{len(d.findings)} finding{'s' if len(d.findings) > 1 else ''}.** The baseline "
@@ -52,11 +79,10 @@ def summary(d: Diagnosis) -> str:
     lines += ["", f"Final model: {' + '.join(d.final.problem.model.names)}"
               + (f" with {', '.join(type(m).__name__ for m in d.final.problem.measurement)}"
                  if d.final.problem.measurement else "")
-              + f"; RMS residual {d.baseline.rms_residual:.3g} N -> {d.final.rms_residual:.3g} N "
-              f"(noise in the fitted band about {ev.noise_rms:.3g} N).", ""]
-    lines += ["## What the baseline gets wrong", "",
-              f"- RMS residual {ev.rms_residual:.3g} N on the fitted samples; measurement noise in the "
-              f"fitted band {ev.noise_rms:.3g} N ({'within' if ev.within_noise else 'above'} the noise).",
+              + f"; RMS residual {d.baseline.rms_residual:.3g} N -> {d.final.rms_residual:.3g} N; "
+              f"final {d.final_evidence.noise.text()}.", ""]
+    lines += ["## The baseline's residual", "",
+              f"- RMS {ev.rms_residual:.3g} N on the fitted samples; {ev.noise.text()}.",
               f"- Drive: {_drive_text(ev)}."]
     for p in ev.peaks:
         kind = f"drive harmonic {p.harmonic}" if p.harmonic else "not a drive harmonic"
@@ -64,8 +90,10 @@ def summary(d: Diagnosis) -> str:
                      f"coherence with the excitation {p.coherence:.2f} ({kind}).")
     for k, a in ev.harmonics.items():
         lines.append(f"- Residual at {k} x drive: {a:.3g} N.")
+    white = "white" if ev.ljung_box_p >= 0.05 else "correlated from sample to sample"
     lines.append(f"- Whiteness: Ljung-Box Q = {ev.ljung_box_q:.0f} (20 lags), p = {ev.ljung_box_p:.2g} "
-                 "(the 10 Hz force filter correlates neighbouring samples).")
+                 f"({white}" + (f"; the {cut:g} Hz force filter itself correlates neighbouring "
+                                "samples" if cut else "") + ").")
     lines.append(f"- Timing skew: correlation of the residual with dF/dt {ev.skew_correlation:+.2f} "
                  f"(implied delay {1e3 * ev.skew_delay:.1f} ms).")
     if ev.frequency_ratio:
@@ -80,13 +108,14 @@ def summary(d: Diagnosis) -> str:
                   "|---|---|---|---|---|---|"]
         accepted = {i: f.added for i, f in enumerate(d.findings, 1)}  # round -> what it added
         for i, rnd in enumerate(d.rounds, 1):
-            for c in rnd:
-                verdict = "accepted" if accepted.get(i) == c.added else (c.rejected or "smaller gain")
-                lines.append(f"| {i} | {c.cause} | {', '.join(c.added)} | {100 * c.gain:.1f} % | "
-                             f"{c.bic_change:+.0f} | {verdict} |")
+            lines += [_candidate_row(i, c, c.fitted and accepted.get(i) == c.added) for c in rnd]
     lines += ["", "## Final parameters", ""] + _parameter_rows(d.final)
     lines += ["", f"{d.candidate_fits} fits in {d.seconds:.1f} s. Held-out RMS: 3 of 10 interleaved "
-              f"blocks left out of every fit. {d.final.interval_note()}", ""]
+              f"blocks left out of every fit but the final one. {d.final.interval_note()}", ""]
+    ended = d.budget_ended
+    if ended:
+        lines += ["Fits ended by their budget (iterations or CPU time, scaled with the record):", ""]
+        lines += [f"- {f.text()}" for f in ended] + [""]
     lines += [f"Note: {n}" for n in d.notes]
     return "\n".join(lines) + "\n"
 
@@ -103,8 +132,11 @@ def write_report(d: Diagnosis, folder: str | Path, *, overwrite: bool = False) -
                dpi=100)
     style.save(residual_spectra_figure(d, folder / "residual_spectra.png"),
                folder / "residual_spectra.png", dpi=100)
-    (folder / "parameters.md").write_text("\n".join(["# Baseline", ""] + _parameter_rows(d.baseline)
-                                                    + ["", "# Final", ""] + _parameter_rows(d.final)) + "\n")
+    held = "3 of 10 interleaved blocks held out" if d.baseline.weights else "every sample"
+    (folder / "parameters.md").write_text("\n".join([f"# Baseline (fitted on {held})", ""]
+                                                    + _parameter_rows(d.baseline)
+                                                    + ["", "# Final (fitted on every sample)", ""]
+                                                    + _parameter_rows(d.final)) + "\n")
     (folder / "summary.md").write_text(summary(d))
     (folder / "diagnosis.json").write_text(json_text(d.to_dict()))
     return folder / "summary.md"
@@ -129,9 +161,15 @@ def before_after_figure(d: Diagnosis, path: str | Path | None = None):
     t = np.asarray(d.baseline.problem.experiments[0].case.time, float)
     meas = d.baseline.measured[0]
     base, final = d.baseline.simulated(0), d.final.simulated(0)
+    # the baseline's simulation in its held-out blocks follows a carriage motion read off
+    # the displacement alone: shaded and left blank, as in its residual panel
+    held_base = (d.baseline.weights[0] == 0) if d.baseline.weights else np.zeros(t.size, bool)
+    base = np.where(held_base, np.nan, base)
     fig = style.figure(path, figsize=(10, 8.5))
     ax = fig.subplots(3, 1, sharex=True, height_ratios=[2.2, 1, 1])
-    ax[0].plot(t, meas, **style.MEASURED, label="measured (filtered)")
+    for lo, hi in _runs(t, held_base):
+        ax[0].axvspan(lo, hi, color="#fee08b", alpha=0.5, lw=0, zorder=0)
+    ax[0].plot(t, meas, **style.MEASURED, label=_measured_label(d.baseline))
     base_style = {**style.SIMULATED, "color": "#e08214", "ls": (0, (2, 1.5))}
     final_style = {**style.SIMULATED, "ls": "-"}
     ax[0].plot(t, base, **base_style, label=f"baseline ({_model_text(d.baseline)})")
@@ -162,20 +200,23 @@ def before_after_figure(d: Diagnosis, path: str | Path | None = None):
                 style.robust_limit(d.final.residuals[0], fitted(d.final)))
     noise = d.baseline_evidence.noise_rms
     for a, res, name in ((ax[1], d.baseline, "baseline"), (ax[2], d.final, "final")):
-        r = res.residuals[0]
+        # the held-out blocks are no residual of the fitted model: the carriage motion there
+        # rests on the displacement alone, so they are shaded and left blank
+        held = (res.weights[0] == 0) if res.weights else np.zeros(t.size, bool)
+        r = np.where(held, np.nan, res.residuals[0])
         a.axhspan(-noise, noise, color="#4393c3", alpha=0.2, lw=0, label=f"noise RMS +/-{noise:.3g} N")
         a.plot(t, r, **style.RESIDUAL, label=f"{name} residual")
-        if res.weights:
-            for i, (lo, hi) in enumerate(_runs(t, res.weights[0] == 0)):
-                a.axvspan(lo, hi, color="#fee08b", alpha=0.35, lw=0, zorder=0,
-                          label="held out of the fit" if i == 0 else None)
-        style.mark_startup(a, t, np.abs(r), end, limit, "N")
-        rms = float(np.sqrt(np.mean(r[fitted(res)] ** 2)))
+        for i, (lo, hi) in enumerate(_runs(t, held)):
+            a.axvspan(lo, hi, color="#fee08b", alpha=0.5, lw=0, zorder=0,
+                      label="held out of this fit (not shown)" if i == 0 else None)
+            a.text(0.5 * (lo + hi), 0.0, "held out", ha="center", va="center", fontsize="small",
+                   color="0.35")
+        style.mark_startup(a, t, np.abs(np.nan_to_num(r)), end, limit, "N")
+        rms = float(np.sqrt(np.mean(res.residuals[0][fitted(res)] ** 2)))
         a.set(ylabel="residual [N]", ylim=(-limit, limit))
-        a.set_title(f"{name} ({_model_text(res)}): RMS residual {res.rms_residual:.3g} N "
-                    f"({rms:.3g} N on the fitted samples after the start-up)", fontsize="medium",
-                    loc="left")
-        a.legend(loc="upper right", fontsize="small", ncols=3)
+        a.set_title(f"{name} ({_model_text(res)}): RMS residual {rms:.3g} N on the fitted samples "
+                    "after the start-up", fontsize="medium", loc="left")
+        a.legend(loc="lower right", fontsize="small", ncols=4)
     ax[2].set_xlabel("time [s]")
     fig.suptitle(f"Diagnosis of {d.baseline.problem.experiments[0].case.test.id}: before and after")
     return fig
@@ -194,15 +235,20 @@ def residual_spectra_figure(d: Diagnosis, path: str | Path | None = None):
     fig = style.figure(path, figsize=(10, 5))
     ax = fig.subplots()
     curves = []
-    for y, label, kw in ((d.baseline.measured[0], "measured (filtered)", {"color": "0.75", "lw": 1.0}),
-                         (d.baseline.residuals[0], f"baseline residual ({_model_text(d.baseline)})",
-                          {"color": "#e08214", "lw": 2.4, "alpha": 0.7}),
-                         (d.final.residuals[0], f"final residual ({_model_text(d.final)})",
-                          {"color": "0.1", "lw": 0.9})):
+    # the baseline's residual on its fitted samples only (held-out blocks zeroed, the
+    # density scaled back by the fitted share): the held-out blocks are no residual of it
+    w = d.baseline.weights[0] > 0 if d.baseline.weights else np.ones(t.size, bool)
+    for y, share, label, kw in (
+            (d.baseline.measured[0], 1.0, _measured_label(d.baseline), {"color": "0.75", "lw": 1.0}),
+            (np.where(w, d.baseline.residuals[0], 0.0), float(np.mean(w)),
+             f"baseline residual ({_model_text(d.baseline)}), fitted samples",
+             {"color": "#e08214", "lw": 2.4, "alpha": 0.7}),
+            (d.final.residuals[0], 1.0, f"final residual ({_model_text(d.final)})",
+             {"color": "0.1", "lw": 0.9})):
         sp = welch_spectrum(t, y)
         band = (sp.frequency <= top_f)
-        ax.semilogy(sp.frequency[band], np.sqrt(sp.psd[band]), label=label, **kw)
-        curves.append(np.sqrt(sp.psd[band & (sp.frequency > 0)]))
+        ax.semilogy(sp.frequency[band], np.sqrt(sp.psd[band] / share), label=label, **kw)
+        curves.append(np.sqrt(sp.psd[band & (sp.frequency > 0)] / share))
     floor = noise_density(d.baseline, "force_x")
     if floor is not None:
         ax.axhline(floor, label="noise floor (raw data)", gid="noise floor", **style.NOISE)
@@ -219,7 +265,8 @@ def residual_spectra_figure(d: Diagnosis, path: str | Path | None = None):
         ax.axvspan(cut, top_f, **style.DISCOUNT, label=f"above the {cut:g} Hz force filter")
     ax.set(xlabel="frequency [Hz]", ylabel="amplitude density [N/sqrt(Hz)]", xlim=(0, top_f),
            ylim=style.spectrum_limits(curves, floor))
-    ax.set_title("Residual spectra: what the baseline misses and the final model explains"
+    ax.set_title(("Residual spectra: what the baseline misses and the final model explains"
+                  if d.findings else "Residual spectra of the baseline (no finding)")
                  + (" (drive: a sweep)" if drive is None else ""))
     ax.legend(loc="upper right", fontsize="small", ncols=2)
     return fig

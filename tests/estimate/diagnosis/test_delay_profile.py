@@ -1,4 +1,4 @@
-"""The sensor delay's linearised profile (``estimate.diagnosis.screening.delay_profile``):
+"""The sensor delay's linearised profile (``estimate.diagnosis.families.delay.delay_profile``):
 on a record of the independent reference simulator whose force is recorded 30 ms late, the
 profile linearised at the fit without delay has its minimum at the simulated delay, and
 the objective reduction it predicts there agrees with an actual fit at that delay.
@@ -14,9 +14,10 @@ import pytest
 import reference_models as ref
 from synthetic_cases import make_case, pendulum
 
+from estimate.diagnosis.families.delay import delay_profile
+from estimate.diagnosis.fitter import Fitter
 from estimate.diagnosis.scoring import holdout_weights
-from estimate.diagnosis.screening import delay_profile
-from estimate.diagnosis.search import _Fitter, baseline_model, force_cutoff
+from estimate.diagnosis.search import baseline_model, force_cutoff
 from estimate.fitting.linearise import linearise
 from estimate.fitting.measurement import SensorDelay
 
@@ -24,7 +25,7 @@ from estimate.fitting.measurement import SensorDelay
 def test_linearised_delay_profile_finds_the_simulated_delay(tmp_path):
     case, _ = make_case(tmp_path, "late", ref.LinearSweep(0.003, 1.0, 4.0, 30.0),
                         pendulums=[pendulum(1.30, 0.0553, 0.01)], seed=17, sensor_delay=0.03)
-    fitter = _Fitter([case], [holdout_weights(case.time.size)], "estimated", force_cutoff([case]))
+    fitter = Fitter([case], [holdout_weights(case.time.size)], "estimated", force_cutoff([case]))
     model = baseline_model(case)
     base = fitter(model, (), {})
     lin = linearise(fitter.problem(model, (), dict(zip(base.names, base.values))),

@@ -1,0 +1,99 @@
+"""Recall table of the diagnosis (slow suite): the full ``diagnose`` on fixed records of the
+independent reference simulator (``tests/reference_diagnosis_records.py``): at least two
+records per lateral-rig family, the compounds and regressions of issue 24 (a second mode
+in a 0.2 mm chirp at 80 % fill; a second mode with a sensor delay; a hardening hinge at
+80 % fill; a diaphragm spring with a second mode, an offset and drift), and clean controls
+of different drives and tank sizes. A change that loses a family fails a row.
+
+Each row must name exactly its causes (any order; a control names nothing), explain the
+data, recover the named parameters within the record's tolerance (15 % unless stated: the
+hidden effects are well above the noise), and stay within the diagnosis's CPU-time budget
+(:data:`estimate.diagnosis.fitter.SECONDS_PER_SAMPLE`, 45 s for 30 s at 100 Hz) plus the
+final fit's: 60 s of CPU time (issue 24: no record of <= 30 s at 100 Hz over 60 s on 2
+cores). CPU time, not wall time: it does not depend on what else the machine runs.
+
+The spinning-rig families (rotor, rotary oscillator) have their records in
+``test_spinning_diagnose.py`` (minutes each).
+
+Run ``python tests/estimate/diagnosis/test_recall.py [NAME ...]`` to print the table
+(record, hidden effect, named causes, parameters against the truth, CPU and wall time).
+"""
+
+from __future__ import annotations
+
+import sys
+import time
+from pathlib import Path
+
+import pytest
+
+if __name__ == "__main__":  # run as a script: the records live in tests/
+    sys.path.append(str(Path(__file__).resolve().parents[2]))
+
+import reference_diagnosis_records as R  # noqa: E402
+
+from estimate import diagnose  # noqa: E402
+
+#: CPU seconds a diagnosis of a 30 s, 100 Hz record may take (see the module docstring).
+MAX_CPU = 60.0
+
+
+def run(name: str, folder) -> dict:
+    """Diagnose record ``name``; its row of the table."""
+    rec = R.RECORDS[name]
+    case, _ = R.build(name, folder)
+    cpu, wall = time.process_time(), time.perf_counter()
+    d = diagnose(case, progress=False)
+    cpu, wall = time.process_time() - cpu, time.perf_counter() - wall
+    final = dict(zip(d.final.names, d.final.values))
+    return {"record": name, "effect": rec.effect, "expected": rec.causes,
+            "named": tuple(f.cause for f in d.findings), "explained": not d.unexplained,
+            "verdict": d.verdict.text,
+            "parameters": {k: (final.get(k, float("nan")), v) for k, v in rec.truth.items()},
+            "tolerance": rec.tolerance, "cpu": cpu, "wall": wall,
+            "budget_ended": [f.text() for f in d.budget_ended]}
+
+
+def check(row: dict) -> None:
+    assert sorted(row["named"]) == sorted(row["expected"]), row["verdict"]
+    assert row["explained"], row["verdict"]
+    for name, (value, truth) in row["parameters"].items():
+        assert value == pytest.approx(truth, rel=row["tolerance"]), name
+    assert row["cpu"] < MAX_CPU, (row["cpu"], row["budget_ended"])
+
+
+@pytest.mark.slow
+@pytest.mark.parametrize("name", [
+    pytest.param(n, marks=pytest.mark.xfail(strict=True, reason=r.known) if r.known else ())
+    for n, r in R.RECORDS.items()])
+def test_recall(name, tmp_path):
+    check(run(name, tmp_path))
+
+
+def _table(rows: list[dict]) -> str:
+    out = ["| record | hidden effect | named | parameter vs truth | CPU s | wall s | pass |",
+           "|---|---|---|---|---|---|---|"]
+    for r in rows:
+        try:
+            check(r)
+            ok = "yes"
+        except AssertionError as err:
+            ok = f"NO: {str(err).splitlines()[0][:80]}"
+        if R.RECORDS[r["record"]].known:
+            ok += " (known failure)"
+        params = "; ".join(f"`{k}` {v:.4g} ({100 * (v / t - 1):+.1f} %)"
+                           for k, (v, t) in r["parameters"].items()) or "-"
+        out.append(f"| {r['record']} | {r['effect']} | {', '.join(r['named']) or 'none'} | "
+                   f"{params} | {r['cpu']:.1f} | {r['wall']:.1f} | {ok} |")
+    return "\n".join(out)
+
+
+if __name__ == "__main__":
+    import tempfile
+
+    names = sys.argv[1:] or list(R.RECORDS)
+    rows = []
+    for n in names:
+        rows.append(run(n, Path(tempfile.mkdtemp())))
+        print(_table(rows[-1:]).splitlines()[-1], flush=True)
+    print(_table(rows))
