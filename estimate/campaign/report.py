@@ -17,7 +17,7 @@ import tempfile
 from pathlib import Path
 from typing import Any
 
-from ..diagnosis.evidence import NOISE_MARGIN
+from ..diagnosis.scoring import NOISE_MARGIN
 from ..inputs import load_json
 from .discovery import Setup
 from .outliers import FAMILY_ERROR, MIN_RECORDS

@@ -72,7 +72,7 @@ class Finding:
 @dataclass(frozen=True)
 class Verdict:
     """Whether the final model explains the data: its residual over the measurement noise
-    (``ratio``, explained when at most :data:`~estimate.diagnosis.evidence.NOISE_MARGIN`),
+    (``ratio``, explained when at most :data:`~estimate.diagnosis.scoring.NOISE_MARGIN`),
     and when it does not, where the residual concentrates and the best candidates that
     were rejected, in one sentence."""
 

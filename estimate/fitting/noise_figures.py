@@ -68,7 +68,7 @@ def residual_over_noise(result: "FitResult", case: int = 0) -> float:
     """The residual of ``case`` over its noise figure: the RMS residual on the fitted samples
     over the figure (for several channels, the RMS of each channel's ratio). A correct model
     leaves about 1; the diagnosis calls a fit within the noise up to
-    :data:`estimate.diagnosis.evidence.NOISE_MARGIN`."""
+    :data:`estimate.diagnosis.scoring.NOISE_MARGIN`."""
     figures = result.noise_figures[case] if result.noise_figures else {}
     if not figures:
         return math.nan

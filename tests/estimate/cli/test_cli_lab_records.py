@@ -13,6 +13,7 @@ import reference_rig_records as rig
 from estimate.cli import main
 from estimate.data import write_case
 from estimate.data.case import Liquid, Rig, Tank, TestInfo
+from estimate.fitting.carriage import KNOTS_PER_PERIOD
 
 
 @pytest.fixture(scope="module")
@@ -40,8 +41,10 @@ def test_fit_says_what_was_done_to_the_timestamps(jittered, tmp_path, capsys):
     assert "note: j.csv: [test] resample_hz = 100: timestamps jitter by up to 2" in printed
     data = json.loads(out.read_text())
     assert any("receive times of uniformly taken samples" in n for n in data["notes"])
-    # --motion-band 3 Hz: knots at most 1 / (12 x 3 Hz) apart, the record cut in equal parts
-    assert 0.99 / 36 < data["noise"][0]["knot_spacing_s"] <= 1 / 36
+    # --motion-band 3 Hz: knots at most 1 / (KNOTS_PER_PERIOD x 3 Hz) apart, the record cut
+    # in equal parts
+    top = 1 / (KNOTS_PER_PERIOD * 3.0)
+    assert 0.99 * top < data["noise"][0]["knot_spacing_s"] <= top
 
 
 @pytest.mark.parametrize("value", ["0", "-2", "fast", "nan"])
