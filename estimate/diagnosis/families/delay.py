@@ -126,6 +126,9 @@ class SensorDelay(Family):
         score = self._score(ctx, profile)
         if score >= MIN_SCORE:
             return None
+        if score <= 0.05:
+            return (f"the objective's profile over the delay predicts no reduction (a score "
+                    f"of {MIN_SCORE:.0f} is needed): no delay fits the record better")
         return (f"the objective's profile over the delay predicts a reduction of "
                 f"{score:.1f} (needs {MIN_SCORE:.0f}); best delay {1e3 * profile.best:.1f} ms")
 

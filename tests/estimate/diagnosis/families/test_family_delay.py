@@ -30,4 +30,4 @@ def test_no_delay_is_proposed_on_a_clean_chirp(clean_sweep):
     run = run_family(clean_sweep, "sensor_delay", fit=False)
     assert not run.proposed
     why = family("sensor_delay").why_not(run.context)
-    assert "the objective's profile over the delay predicts a reduction of" in why, why
+    assert "the objective's profile over the delay predicts" in why, why
