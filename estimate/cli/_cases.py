@@ -9,7 +9,7 @@ from typing import TYPE_CHECKING
 if TYPE_CHECKING:  # the parser of every command imports this module: load nothing yet
     from ..data import Case
 
-__all__ = ["add_strict", "load_cases", "positive_hz"]
+__all__ = ["add_force", "add_strict", "load_cases", "positive_hz"]
 
 
 def add_strict(parser) -> None:
@@ -17,6 +17,14 @@ def add_strict(parser) -> None:
     parser.add_argument("--strict", action="store_true",
                         help="refuse case files with unknown keys or tables (default: a warning "
                              "naming the key and the nearest known name)")
+
+
+def add_force(parser) -> None:
+    """The ``--force`` option of a command that takes a fit result
+    (:func:`estimate.fitting.params_io.fit_notes`)."""
+    parser.add_argument("--force", action="store_true",
+                        help="use a fit result that did not converge (`converged: false`), with "
+                             "a warning; refused without it")
 
 
 def load_cases(paths: Sequence[str], *, prediction: bool = False, strict: bool = False,

@@ -10,7 +10,7 @@ import sys
 from analogs.errors import InputError
 
 from ..outputs import Outputs, json_text
-from ._cases import add_strict
+from ._cases import add_force, add_strict
 
 __all__ = ["add_parser", "parse_duration"]
 
@@ -62,9 +62,7 @@ def add_parser(sub: argparse._SubParsersAction) -> None:
                         "JSON's name with `_drive.csv`)")
     p.add_argument("--plot", default=None, help="write the design plot (PNG)")
     p.add_argument("--overwrite", action="store_true", help="replace existing output files")
-    p.add_argument("--force", action="store_true",
-                   help="use a fit result that did not converge (`converged: false`), with a "
-                        "warning; refused without it")
+    add_force(p)
     add_strict(p)
     p.set_defaults(run=run)
 

@@ -18,6 +18,7 @@ from analogs.errors import InputError
 from analogs.vehicle import VehicleFrame, axisymmetric, degrees_of_freedom
 
 from ..outputs import Outputs
+from ._cases import add_force
 
 __all__ = ["add_parser", "run", "export_model"]
 
@@ -68,9 +69,7 @@ def add_parser(subparsers: argparse._SubParsersAction) -> None:
                    help="FMU: largest internal RK4 step, s (default 0.01)")
     p.add_argument("--no-build", action="store_true", help="do not compile the C driver")
     p.add_argument("--overwrite", action="store_true", help="replace existing output files")
-    p.add_argument("--force", action="store_true",
-                   help="use a fit result that did not converge (`converged: false`), with a "
-                        "warning; refused without it")
+    add_force(p)
     p.set_defaults(run=run)
 
 

@@ -13,7 +13,7 @@ from pathlib import Path
 from analogs.errors import InputError
 
 from ..outputs import Outputs, json_text
-from ._cases import add_strict
+from ._cases import add_force, add_strict
 
 __all__ = ["add_parser", "run"]
 
@@ -42,9 +42,7 @@ def add_parser(subparsers: argparse._SubParsersAction) -> None:
     p.add_argument("--out", metavar="DIR", default="montecarlo",
                    help="output folder for montecarlo.json and envelope.png (default ./montecarlo)")
     p.add_argument("--overwrite", action="store_true", help="replace existing output files")
-    p.add_argument("--force", action="store_true",
-                   help="use a fit result that did not converge (`converged: false`), with a "
-                        "warning; refused without it")
+    add_force(p)
     add_strict(p)
     p.set_defaults(run=run)
 

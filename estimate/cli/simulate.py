@@ -8,7 +8,7 @@ import sys
 from analogs.errors import InputError
 
 from ..outputs import Outputs
-from ._cases import add_strict
+from ._cases import add_force, add_strict
 
 __all__ = ["add_parser"]
 
@@ -31,9 +31,7 @@ def add_parser(sub: argparse._SubParsersAction) -> None:
     p.add_argument("--integrator", choices=("rk4", "adaptive"), default="rk4",
                    help="fixed-step RK4 on the sample grid (default) or CVODES")
     p.add_argument("--overwrite", action="store_true", help="replace an existing --out file")
-    p.add_argument("--force", action="store_true",
-                   help="use a fit result that did not converge (`converged: false`), with a "
-                        "warning; refused without it")
+    add_force(p)
     add_strict(p)
     p.set_defaults(run=run)
 
