@@ -93,6 +93,9 @@ def test_robust_intervals_cover_the_truth_on_a_transducer_record(tmp_path):
 
 
 @pytest.mark.slow
+@pytest.mark.xfail(strict=True, reason="issue 25, open: a missing second mode biases the first "
+                   "mode's estimates beyond any covariance of the noise; measured over 100 draws "
+                   "the robust intervals covered p1.mass 15, p1.length 0, p1.damping 36 times")
 def test_robust_intervals_cover_the_first_mode_when_a_second_is_missing(tmp_path):
     """The record holds a second slosh mode of 5 % of the first's mass (at 1.9 times its
     frequency) that the fitted model lacks: over 100 noise draws the robust intervals cover
