@@ -121,13 +121,15 @@ def transport_record(folder: Path, tank: TransportTank, *, distance: float = 0.4
                      ripple_frequency: float = 18.0, planned: bool = False, seed: int = 0,
                      name: str | None = None, dry_mass: float | str = "estimate",
                      encoder_noise: float = 1e-5, encoder_resolution: float = 5e-6,
-                     **case_options) -> TransportRecord:
+                     jitter: float = 0.0, **case_options) -> TransportRecord:
     """Write a transport record of ``tank`` to ``folder``: at rest for ``start`` s, a move
     of ``distance`` m in ``duration`` s, then ``decay`` s of free decay, sampled at ``rate``
     Hz on a uniform grid; the force stream lags by ``sensor_delay`` s (plus its filter's
     group delay); the displacement column is the encoder reading of the true motion, or
     with ``planned`` the commanded path (which leads the true motion by ``servo_lag``).
-    ``dry_mass`` is what the case file says (default ``"estimate"``: unknown)."""
+    ``dry_mass`` is what the case file says (default ``"estimate"``: unknown); ``jitter``
+    (s): the time column holds receive times +/- ``jitter`` about the sampling instants
+    (:func:`reference_rig_records.receive_times`) and the case asks for ``resample_hz``."""
     from estimate.data import write_case
     from estimate.data.case import Liquid, Rig, Tank, TestInfo
 
@@ -152,6 +154,10 @@ def transport_record(folder: Path, tank: TransportTank, *, distance: float = 0.4
         x = rr.encoder_position(sim["displacement_clean"], rng=rng, noise=encoder_noise,
                                 resolution=encoder_resolution)
     name = name or f"{tank.name}_{'planned' if planned else 'measured'}_{seed}"
+    stamps = t
+    if jitter > 0:
+        stamps = rr.receive_times(t, jitter=jitter, rng=rng)
+        case_options = {"resample_hz": rate, **case_options}
     case = write_case(
         Path(folder) / f"{name}.toml",
         test=TestInfo(id=name, rig="lateral", data=f"{name}.csv", excitation="measured",
@@ -161,7 +167,7 @@ def transport_record(folder: Path, tank: TransportTank, *, distance: float = 0.4
                   diaphragm=False,
                   length=2 * tank.radius if tank.shape == "cylinder" else None),
         liquid=Liquid(density=WATER, kinematic_viscosity=1.004e-6),
-        rig=Rig(dry_mass=None if dry_mass == "estimate" else dry_mass, gravity=G), time=t,
+        rig=Rig(dry_mass=None if dry_mass == "estimate" else dry_mass, gravity=G), time=stamps,
         force=force, displacement=x,
         prediction=tank.prediction,
         comment="SYNTHETIC transport record (tests/transport_cases.py)", overwrite=True)
