@@ -72,8 +72,14 @@ def fit_json(folder: Path, name: str, cases, spec: str = "fixed,p1", **build) ->
 
 
 def halfwidth(res, name: str) -> float:
-    """95 % half-width of an estimate over its value (as the design states it)."""
-    return 1.959963984540054 * res.stderr[res.names.index(name)] / abs(res.value(name))
+    """95 % half-width of an estimate over its value (as the design states it); for an
+    estimate at a bound, from the standard deviation the data allow it away from the bound
+    (``FitResult.bound_stderr``: a confounded length slides to its bound)."""
+    i = res.names.index(name)
+    se = res.stderr[i]
+    if not np.isfinite(se) and res.bound_stderr is not None:
+        se = res.bound_stderr[i]
+    return 1.959963984540054 * se / abs(res.value(name))
 
 
 def swing_scaled(drive_of_amplitude, truth: ref.Pendulum, max_swing: float,
