@@ -153,8 +153,8 @@ def _plot(args: argparse.Namespace, tank, liquid: Liquid, path: str, pred) -> No
 
 
 #: Unit of each numeric option (ranges: :data:`estimate.data.case.PHYSICAL_RANGES`).
-_UNITS = {"radius": "m", "length": "m", "width": "m", "height": "m", "density": "kg/m^3", "viscosity": "m^2/s",
-          "gravity": "m/s^2"}
+_UNITS = {"radius": "m", "length": "m", "width": "m", "height": "m", "density": "kg/m^3",
+          "viscosity": "m^2/s", "gravity": "m/s^2"}
 
 
 def _check_ranges(args: argparse.Namespace) -> None:

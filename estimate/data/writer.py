@@ -15,8 +15,18 @@ from typing import Any
 import numpy as np
 from numpy.typing import ArrayLike, NDArray
 
-from .case import (DRY_MASS_ESTIMATE, LIMIT_UNITS, SHAPE_KEYS, SPINNING_CHANNELS, Case, Liquid,
-                   Prediction, Rig, Tank, TestInfo)
+from .case import (
+    DRY_MASS_ESTIMATE,
+    LIMIT_UNITS,
+    SHAPE_KEYS,
+    SPINNING_CHANNELS,
+    Case,
+    Liquid,
+    Prediction,
+    Rig,
+    Tank,
+    TestInfo,
+)
 from .reader import load_case
 
 __all__ = ["write_case"]

@@ -35,8 +35,7 @@ from .evidence import collect_evidence, segment_damping
 from .families import FAMILIES, Context, Proposal, Score
 from .fitter import Fitter
 from .outcome import CandidateOutcome, Diagnosis, Finding, Verdict
-from .scoring import (MIN_SCORE, bic, far_from_noise, heldout, holdout_weights, noise_figure,
-                      poor_start)
+from .scoring import MIN_SCORE, bic, far_from_noise, heldout, holdout_weights, noise_figure, poor_start
 from .screening import screen
 
 __all__ = ["Diagnosis", "Finding", "CandidateOutcome", "diagnose", "baseline_model",
