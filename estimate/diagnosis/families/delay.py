@@ -96,6 +96,14 @@ def _delay_of(r: FitResult) -> float:
     return next(mm.delay for mm in r.problem.measurement if isinstance(mm, SensorDelayModel))
 
 
+def _inside_range(r: FitResult) -> str | None:
+    """Why the fitted delay is not physical (at the edge of :data:`DELAY_RANGE`), or None."""
+    tau = _delay_of(r)
+    if DELAY_RANGE[0] + 1e-3 <= tau <= DELAY_RANGE[1] - 5e-3:
+        return None
+    return f"the delay {1e3 * tau:.1f} ms is at the edge of the searched range"
+
+
 class SensorDelay(Family):
     """A late force recording (a timing skew between the channels): a sensor delay on the
     measured force, placed by a linearised profile and refitted."""
@@ -158,12 +166,6 @@ class SensorDelay(Family):
                 prof = _profile_at(fitter, at, measured)
             return best
 
-        def plausible(r: FitResult) -> str | None:
-            tau = _delay_of(r)
-            if not DELAY_RANGE[0] + 1e-3 <= tau <= DELAY_RANGE[1] - 5e-3:
-                return f"the delay {1e3 * tau:.1f} ms is at the edge of the searched range"
-            return None
-
         def describe(r: FitResult) -> str:
             return (f"the objective's profile over a delay of the recorded force is lowest "
                     f"away from zero (residual correlation with dF/dt "
@@ -172,4 +174,4 @@ class SensorDelay(Family):
 
         return [Proposal(self.cause, ("sensor_delay",), ctx.model, ctx.measurement, {},
                          score=self._score(ctx, profile),
-                         fit=fit, extra_parameters=1, plausible=plausible, describe=describe)]
+                         fit=fit, extra_parameters=1, plausible=_inside_range, describe=describe)]
