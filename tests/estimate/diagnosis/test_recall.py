@@ -28,7 +28,9 @@ from pathlib import Path
 
 import pytest
 
-if __name__ == "__main__":  # run as a script: the records live in tests/
+if __name__ == "__main__":  # run as a script: the records live in tests/, whose estimate/
+    # folder must not shadow the package (the repository goes first)
+    sys.path.insert(0, str(Path(__file__).resolve().parents[3]))
     sys.path.append(str(Path(__file__).resolve().parents[2]))
 
 import reference_diagnosis_records as R  # noqa: E402
