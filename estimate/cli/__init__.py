@@ -42,14 +42,34 @@ def main(argv: list[str] | None = None) -> int:
     try:
         status = _main(argv)
     except KeyboardInterrupt:  # before the command's own handlers: its libraries loading
-        print("slosh: interrupted by SIGINT while starting: nothing was written",
-              file=sys.stderr)
-        return 130
+        return _interrupted_while_starting()
+    except Exception as exc:
+        # a SIGINT inside an extension module's own import (NumPy's core importing
+        # `datetime` through PyCapsule_Import) surfaces as an ImportError caused by it
+        if _caused_by_interrupt(exc):
+            return _interrupted_while_starting()
+        raise
     if argv is None:  # the `slosh` program: done, a Ctrl-C while Python exits changes nothing
         import signal
 
         signal.signal(signal.SIGINT, signal.SIG_IGN)
     return status
+
+
+def _interrupted_while_starting() -> int:
+    print("slosh: interrupted by SIGINT while starting: nothing was written", file=sys.stderr)
+    return 130
+
+
+def _caused_by_interrupt(exc: BaseException) -> bool:
+    """Whether a KeyboardInterrupt is in the cause or context chain of ``exc``."""
+    seen = set()
+    while exc is not None and id(exc) not in seen:
+        if isinstance(exc, KeyboardInterrupt):
+            return True
+        seen.add(id(exc))
+        exc = exc.__cause__ or exc.__context__
+    return False
 
 
 def _main(argv: list[str] | None) -> int:
