@@ -205,6 +205,11 @@ def fit(problem: FitProblem, *, transcription: Transcription = MultipleShooting(
                      *(np.asarray(out[j]).ravel() for j in (0, 2, 3)), J, Je, Jg, t_start,
                      transcription, cost, carriage, xres, states, coefs, tuple(kinds),
                      initial_states)
+    if not result.converged:
+        # a fit that did not converge (its iterations or time budget spent) is no place to
+        # read a noise figure or a residual balance from, and a refit would spend the
+        # budget again
+        return result
     again = reweighed(problem, result.noise_figures)  # a provisional force weight was off
     if again is not None:
         second = fit(again.with_initial(dict(zip(result.names, result.values))),
