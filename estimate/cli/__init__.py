@@ -39,21 +39,34 @@ def main(argv: list[str] | None = None) -> int:
     them: one line says they are complete and the status is the command's (and the
     ``slosh`` program, called without ``argv``, ignores SIGINT once the command returned).
     """
+    import signal
+
+    if signal.getsignal(signal.SIGINT) is signal.default_int_handler:
+        signal.signal(signal.SIGINT, _starting_interrupted)
     try:
         status = _main(argv)
     except KeyboardInterrupt:  # before the command's own handlers: its libraries loading
         return _interrupted_while_starting()
     except Exception as exc:
         # a SIGINT inside an extension module's own import (NumPy's core importing
-        # `datetime` through PyCapsule_Import) surfaces as an ImportError caused by it
-        if _caused_by_interrupt(exc):
+        # `datetime` through PyCapsule_Import) surfaces as an ImportError that may not
+        # even name the KeyboardInterrupt: the handler above noted the signal
+        if _SIGINT_SEEN or _caused_by_interrupt(exc):
             return _interrupted_while_starting()
         raise
     if argv is None:  # the `slosh` program: done, a Ctrl-C while Python exits changes nothing
-        import signal
-
         signal.signal(signal.SIGINT, signal.SIG_IGN)
     return status
+
+
+_SIGINT_SEEN = False
+
+
+def _starting_interrupted(signum, frame) -> None:
+    """Python's own SIGINT behaviour (KeyboardInterrupt), noting that the signal came."""
+    global _SIGINT_SEEN
+    _SIGINT_SEEN = True
+    raise KeyboardInterrupt
 
 
 def _interrupted_while_starting() -> int:
