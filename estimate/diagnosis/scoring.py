@@ -12,19 +12,16 @@ from dataclasses import dataclass
 import numpy as np
 
 from ..data.signals import welch_spectrum
+from ..fitting.noise_figures import MODEL_ERROR_MARGIN
 from ..fitting.result import FitResult
 
 __all__ = ["ResidualOverNoise", "noise_figure", "noise_floor", "within_noise", "holdout_weights",
            "heldout", "bic", "distinct", "case_rows", "far_from_noise", "poor_start",
            "NOISE_MARGIN", "MIN_SCORE", "POOR_START_RATIO"]
 
-#: A residual this many times the measurement noise is within the noise. Correct models
-#: leave 0.99-1.06 times the noise figure on the reference simulator's records (sines below,
-#: at and above resonance, amplitude steps, chirps up and down, a full-size tank; five noise
-#: draws each) and 0.86-1.16 on transport moves whose figure comes from a short rest before
-#: the move (0.84 s at 100 Hz: the figure's own sampling error): see
-#: estimate.fitting.noise_figures.
-NOISE_MARGIN = 1.15
+#: A residual this many times the measurement noise is within the noise: the fit's own
+#: margin, above which its intervals take the model error.
+NOISE_MARGIN = MODEL_ERROR_MARGIN
 #: Score statistic a screened term (or a profiled sensor delay) needs to be fitted (5
 #: standard deviations for one new parameter: a dozen terms are screened each round).
 MIN_SCORE = 25.0
@@ -109,9 +106,11 @@ def noise_figure(result: FitResult, case: int = 0) -> ResidualOverNoise:
 
 
 def distinct(res: FitResult, name: str, factor: float = 3.0) -> bool:
-    """``name`` is estimated and ``factor`` standard errors or more away from zero."""
+    """``name`` is estimated and ``factor`` standard errors of the noise
+    (:attr:`FitResult.noise_stderr`: a candidate that leaves another effect unexplained is
+    not less distinct for it) or more away from zero."""
     i = res.names.index(name) if name in res.names else None
-    return i is not None and abs(res.values[i]) > factor * res.stderr[i]
+    return i is not None and abs(res.values[i]) > factor * res.noise_stderr[i]
 
 
 def case_rows(res: FitResult, case: int) -> slice:

@@ -194,6 +194,20 @@ class _Record:
     acceleration: object
     force: np.ndarray
     keep: np.ndarray
+    #: The acceleration at the lagged times, by lag: the searches evaluate one lag for
+    #: several frequencies and damping ratios (their finite differences)
+    shifted: dict = field(default_factory=dict, repr=False, compare=False)
+
+    def acceleration_at(self, lag: float) -> np.ndarray:
+        """The acceleration at ``time - lag`` (held at its end values outside) [m/s^2]."""
+        a = self.shifted.get(lag)
+        if a is None:
+            if len(self.shifted) > 128:
+                self.shifted.clear()
+            t = self.time
+            a = np.asarray(self.acceleration(np.clip(t - lag, t[0], t[-1])), float)
+            self.shifted[lag] = a
+        return a
 
 
 def _prepared(t, a, F, w, cutoff: float) -> _Record:
@@ -377,8 +391,7 @@ def _bob_acceleration(a: np.ndarray, dt: float, omega: float, zeta: float) -> np
 def _design(rec: _Record, omega: float, zeta: float, lag: float) -> np.ndarray:
     """Columns ``[a(t - lag), b(t - lag), 1]`` of one record (``b`` of the linear mode)."""
     t = rec.time
-    shifted = np.clip(t - lag, t[0], t[-1])
-    a = np.asarray(rec.acceleration(shifted), float)
+    a = rec.acceleration_at(lag)
     b = _bob_acceleration(a, float(t[1] - t[0]), omega, zeta)
     return np.column_stack([a, b, np.ones_like(a)])
 

@@ -154,6 +154,10 @@ class FitResult:
     covariance_kind: str = "gauss-newton"
     #: Per case, the Newey-West bandwidth of the robust covariance (samples).
     bandwidths: tuple[int, ...] = ()
+    #: How much the robust standard errors were widened for model error
+    #: (:func:`~estimate.fitting.noise_figures.model_error_factor`: the residual over its
+    #: noise figure when above the margin), 1 when the residual is within the noise.
+    model_error: float = 1.0
 
     @property
     def bounds_reached(self) -> tuple[str, ...]:
@@ -372,13 +376,22 @@ class FitResult:
             ratio = rb / gn
         return {n: float(r) for n, r in zip(self.names, ratio) if np.isfinite(r) and r > factor}
 
+    @property
+    def noise_stderr(self) -> np.ndarray:
+        """The standard errors without the model-error widening (:attr:`model_error`): the
+        spread the noise alone gives the estimates (NaN at a bound)."""
+        return self.stderr / self.model_error
+
     def interval_note(self) -> str:
         """One sentence: which covariance the standard errors come from, and where the
         Gauss-Newton ones are optimistic."""
         if self.covariance_kind != "robust":
             return "Standard errors: Gauss-Newton covariance (independent residuals)."
         worse = self.optimistic()
-        return ("Standard errors: the covariance robust to correlated residuals (Newey-West); "
+        widened = (f" widened {self.model_error:.3g}x for model error (the residual over its "
+                   "noise figure);" if self.model_error > 1 else "")
+        return ("Standard errors: the covariance robust to correlated residuals (Newey-West);"
+                + widened + " "
                 + ("the Gauss-Newton ones, which assume independent residuals, are optimistic: "
                    + ", ".join(f"{r:.2g}x smaller for `{n}`" for n, r in worse.items()) + "."
                    if worse else f"the Gauss-Newton ones agree within {OPTIMISTIC_FACTOR:g}x."))
@@ -406,6 +419,11 @@ class FitResult:
                      "residuals are white and widens when they are not (coloured transducer "
                      "noise, a filtered force, an effect the model lacks), where the "
                      "Gauss-Newton one is optimistic. ")
+            if self.model_error > 1:
+                text += (f"The residual is {self.model_error:.3g} times its noise figure: the "
+                         "model misses something the noise does not explain, whose bias a "
+                         "covariance of the noise does not bound, so the robust standard "
+                         f"errors are widened by that factor (model error). ")
             worse = self.optimistic()
             if worse:
                 text += ("Here the Gauss-Newton standard errors are optimistic: the robust ones "
@@ -492,6 +510,7 @@ class FitResult:
             "covariance_gauss_newton": None if self.gauss_newton_covariance is None else
             self.gauss_newton_covariance[np.ix_(free, free)].tolist(),
             "newey_west_lags": list(self.bandwidths),
+            "model_error_factor": self.model_error,
             "residual_variance": self.residual_variance,
             "noise_figures": [{c: f.to_dict() for c, f in figs.items()}
                               for figs in self.noise_figures],

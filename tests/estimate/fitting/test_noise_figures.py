@@ -148,3 +148,34 @@ def test_without_a_rest_the_figure_is_read_from_the_residual_and_reweighs(tmp_pa
     assert res.problem.noise[0].figure is not None
     assert res.problem.noise[0].figure.source == "residual"  # re-weighed by it
     assert fig.std == pytest.approx(truth["noise"], rel=0.25)
+
+
+def test_the_model_error_factor_is_the_residual_over_its_figure_above_the_margin():
+    """Hand-computed: a residual of RMS 0.03 N over a figure of 0.01 N widens by 3; one of
+    1.1 times its figure (inside the 1.15 margin) does not widen; of two cases the worse
+    one counts; held-out samples (weight 0) do not count; a six-channel residual takes the
+    RMS of its channels' ratios (2 and 1: sqrt(2.5))."""
+    from estimate.data.signals.noise_figure import NoiseFigure
+    from estimate.fitting.noise_figures import MODEL_ERROR_MARGIN, model_error_factor
+
+    rng = np.random.default_rng(0)
+    fig = {"force_x": NoiseFigure(0.01, "quiet")}
+
+    def residual(rms, n=4000):
+        r = rng.standard_normal(n)
+        return rms * r / np.sqrt(np.mean(r**2))
+
+    ones = np.ones(4000)
+    assert model_error_factor((fig,), (residual(0.03),), (ones,)) == pytest.approx(3.0)
+    assert model_error_factor((fig,), (residual(0.011),), (ones,)) == 1.0
+    assert MODEL_ERROR_MARGIN == pytest.approx(1.15)
+    assert model_error_factor((fig, fig), (residual(0.011), residual(0.02)),
+                              (ones, ones)) == pytest.approx(2.0)
+    held = residual(0.02)
+    held[:1000] = 5.0  # a held-out block the fit did not see
+    w = np.r_[np.zeros(1000), np.ones(3000)]
+    assert model_error_factor((fig,), (held,), (w,)) == pytest.approx(
+        np.sqrt(np.mean(held[1000:] ** 2)) / 0.01)
+    two = {"force_x": NoiseFigure(0.01, "quiet"), "force_y": NoiseFigure(0.02, "quiet")}
+    r2 = np.column_stack([residual(0.02), residual(0.02)])
+    assert model_error_factor((two,), (r2,), (ones,)) == pytest.approx(np.sqrt(2.5))
