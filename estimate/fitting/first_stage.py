@@ -291,7 +291,7 @@ def identify(records, *, frequency_hz: float, gravity: float | None = None,
 
     def search(x0):
         return least_squares(lambda x: _projected(recs, x)[0], x0, bounds=(lo, hi),
-                             x_scale=x_scale, method="trf", xtol=1e-6, ftol=1e-8,
+                             x_scale=x_scale, method="trf", xtol=1e-4, ftol=1e-6,
                              max_nfev=60)
 
     def search_without_lag(x0):
@@ -299,7 +299,7 @@ def identify(records, *, frequency_hz: float, gravity: float | None = None,
         # lag for the mode's phase, and the data then prefer neither clearly
         sol = least_squares(lambda y: _projected(recs, np.r_[y, x0[2:]])[0], x0[:2],
                             bounds=(lo[:2], hi[:2]), x_scale=x_scale[:2], method="trf",
-                            xtol=1e-6, ftol=1e-8, max_nfev=60)
+                            xtol=1e-4, ftol=1e-6, max_nfev=60)
         sol.x = np.r_[sol.x, x0[2:]]
         sol.jac = np.hstack([sol.jac, np.zeros((sol.jac.shape[0], n))])
         return sol
