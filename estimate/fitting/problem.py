@@ -16,7 +16,7 @@ from ..data.case import Case
 from ..data.experiment import Experiment, experiment
 from ..data.models import model_for_case
 from ..data.records import refuse_repeated
-from .budget import LinearBound, Tie, liquid_budget
+from .budget import LinearBound, Tie, liquid_budget, tank_ranges
 from .carriage import CarriageInput, RecordNoise, carriage_input, record_noise
 from .free_decay import rest_holds
 from .initial import length_bounds, nominal_scale, predicted_sources, source_notes
@@ -102,6 +102,10 @@ class FitProblem:
     #: The first stage that started the fit (:class:`~estimate.fitting.first_stage.FirstStage`),
     #: or ``None``.
     first_stage: object = field(default=None, repr=False)
+    #: The ranges of the estimated model parameters that keep the analog inside its tank
+    #: (:func:`~estimate.fitting.budget.tank_ranges`), by parameter name: checked after the
+    #: fit (:attr:`FitResult.outside_tank`), not bounds of the NLP.
+    tank_ranges: Mapping[str, tuple[float, float]] = field(default_factory=dict)
 
     @classmethod
     def build(cls, cases: Case | Sequence[Case], model: Model, *,
@@ -269,6 +273,8 @@ class FitProblem:
                 f"with `initial` (e.g. `FitProblem.build(..., initial={{'{missing[0]}': ...}})`)")
         notes += source_notes(sources, [n for n in names if n not in given])
         g = cases[0].rig.gravity
+        inside = tank_ranges(cases[0], model, names, {
+            n: length_bounds(v)[1] for n, v in predicted.items() if n.endswith(".length")})
         est = []
         for n in names:
             p = params[n]
@@ -296,6 +302,12 @@ class FitProblem:
                 if n == "rig.lag" and stage is not None and n not in given:
                     x0_i = min(max(stage.lags[i], lo), hi)
                 est.append(Estimated(label, n, i, p.unit, x0_i, lo, hi, scale))
+        if first_stage and stage is None:
+            est, spun = _spin_start(exps, w, est, {**start, **exps[0].fixed}, given,
+                                    force_cutoff_hz, inside)
+            if spun is not None:
+                stage = spun
+                notes.append(spun.describe())
         labels = [e.name for e in est]
         if len(set(labels)) != len(labels):
             raise InputError("case ids must be unique when per-case parameters are estimated")
@@ -322,7 +334,8 @@ class FitProblem:
                              "offsets and drifts: `ChannelOffsets()`)")
         notes += _noise_notes(exps, carriage, noise)
         return cls(model, exps, tuple(est), tuple(fixed), force_cutoff_hz, tuple(notes), w,
-                   tuple(measurement), cw, input, carriage, noise, ties, linear, stage)
+                   tuple(measurement), cw, input, carriage, noise, ties, linear, stage,
+                   inside)
 
     def channels(self, i: int) -> tuple[str, ...]:
         """Output names fitted for case ``i``: the model's measured outputs the case has."""
@@ -437,6 +450,26 @@ def _first_stage(cases, model: Model, exps, carriage, noise, weights):
     except (KeyError, InputError, ValueError, ArithmeticError):
         f = math.nan
     return record_stage((exps, carriage, noise, weights), frequency_hz=f, gravity=g)
+
+
+def _spin_start(exps, weights, est: list, start: Mapping[str, float], given,
+                cutoff: float | None, inside: Mapping[str, tuple[float, float]]):
+    """``est`` started from the spinning rig's first stage
+    (:func:`estimate.fitting.spin_stage.spin_stage`, searching within the estimates'
+    bounds and the tank, ``inside``) where it applies (the values the user gave kept), and
+    the stage (``None``: not run)."""
+    if exps[0].case.test.rig != "spinning" or any(e.case is not None for e in est):
+        return est, None
+    from .spin_stage import spin_stage
+
+    box = {e.parameter: (max(e.lower, inside.get(e.parameter, (-math.inf,))[0]),
+                         min(e.upper, inside.get(e.parameter, (0, math.inf))[1])) for e in est}
+    stage = spin_stage(exps, weights, [e.parameter for e in est], start, box, cutoff_hz=cutoff)
+    if stage is None:
+        return est, None
+    out = [replace(e, initial=min(max(stage.values[e.parameter], e.lower), e.upper))
+           if e.parameter in stage.values and e.parameter not in given else e for e in est]
+    return out, stage
 
 
 def _with_lag(measurement: tuple, mode: str, stage, carriage, exps) -> tuple[tuple, str | None]:

@@ -172,11 +172,37 @@ class FitResult:
         return tuple(out) + tuple(self.active_bounds)
 
     @property
+    def outside_tank(self) -> tuple[str, ...]:
+        """Every estimate that puts the analog outside its tank (a height below the bottom
+        or above the top, an inertia beyond the whole liquid's at the wall:
+        :attr:`FitProblem.tank_ranges`), by more than 2 of its standard errors, in words.
+        Empty: the analog is physically possible."""
+        out = []
+        ranges = getattr(self.problem, "tank_ranges", {}) or {}
+        for i, e in enumerate(self.problem.estimated):
+            if e.parameter not in ranges:
+                continue
+            lo, hi = ranges[e.parameter]
+            v = float(self.values[i])
+            se = float(self.stderr[i]) if i < len(self.stderr) else math.nan
+            slack = 2 * se if math.isfinite(se) else 0.0
+            if v < lo - slack or v > hi + slack:
+                side = "below" if v < lo else "above"
+                bound = lo if v < lo else hi
+                out.append(f"{e.name} = {v:.4g} {e.unit} is {side} {bound:.4g} {e.unit}".rstrip())
+        return tuple(out)
+
+    @property
     def verdict(self) -> str:
         """One line: ``converged``, ``converged at a bound: ...`` (naming every bound the
-        fit ends on) or ``NOT converged``, with IPOPT's status."""
+        fit ends on), ``converged outside the tank: ...`` (a physically impossible analog:
+        :attr:`outside_tank`) or ``NOT converged``, with IPOPT's status."""
         if not self.converged:
             return f"NOT converged ({self.status})"
+        outside = self.outside_tank
+        if outside:
+            return (f"converged outside the tank ({self.status}), not a physical analog: "
+                    + "; ".join(outside))
         reached = self.bounds_reached
         if reached:
             return f"converged at a bound ({self.status}): " + "; ".join(reached)
@@ -499,6 +525,7 @@ class FitResult:
             "status": self.status,
             "verdict": self.verdict,
             "at_bound": list(self.bounds_reached),
+            "outside_tank": list(self.outside_tank),
             "first_stage": (None if self.problem.first_stage is None
                             else self.problem.first_stage.to_dict()),
             "confounded": self.confounded(),

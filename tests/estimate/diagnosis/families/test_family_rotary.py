@@ -30,12 +30,6 @@ def _case(tmp_path, oscillator):
 
 
 @pytest.mark.slow  # six-channel spinning-rig fits take minutes
-@pytest.mark.xfail(strict=True, reason="issue 24, open: on this 10 s record (prograde coning "
-                   "at 2.2 Hz) the baseline does not converge from the tank prediction (150 "
-                   "iterations; also without the oscillator in the record, without the liquid "
-                   "bound, from a 3 s segment, with the inertias held at 0); from the truth it "
-                   "converges in 9 iterations, so the scan reads a residual bent by a wrong "
-                   "baseline and proposes nothing")
 def test_rotary_oscillator_is_scanned_and_recovered(tmp_path):
     osc = rs.RotaryOscillator(INERTIA, INERTIA * OMEGA**2, 2 * ZETA * INERTIA * OMEGA)
     run = run_family(_case(tmp_path, osc), "rotary_oscillator")
