@@ -354,11 +354,14 @@ def rejection(current: FitResult, res: FitResult, prop: Proposal, *, heldout_chi
     the current fit, or ``None`` when it is. It must converge; cut the held-out chi-square
     by :data:`MIN_HELDOUT_CHI2`; with noise-weighted residuals, remove
     :data:`MIN_EXCESS_SHARE` of the objective's excess over the noise; lower the BIC by
-    ``max_bic_change``; and have physical parameters (the family's rule)."""
+    ``max_bic_change``; and have physical parameters (inside the tank, and the family's
+    rule)."""
     weighted = bool(current.problem.noise) and all(n is not None for n in current.problem.noise)
     drop, excess = current.objective - res.objective, current.objective - current.dof
     if not res.converged:
         return f"the fit did not converge ({res.status})"
+    if res.outside_tank:
+        return "it puts the analog outside its tank: " + "; ".join(res.outside_tank)
     if not heldout_chi2 >= MIN_HELDOUT_CHI2:
         return (f"held-out chi-square fell by {heldout_chi2:.1f} (needs {MIN_HELDOUT_CHI2:.0f}; "
                 f"held-out RMS gain {100 * gain:.1f} %)")
