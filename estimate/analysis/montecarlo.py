@@ -24,7 +24,7 @@ from analogs.errors import InputError
 from derive import DerivedModel, Excitation, NoExcitation, rk4_step
 
 from ..executor import Executor, LocalExecutor, chunks
-from ..fitting.params_io import Fit, read_fit
+from ..fitting.record import Fit, read_fit
 
 __all__ = ["Fit", "read_fit", "draw_parameters", "MonteCarlo", "MonteCarloResult",
            "monte_carlo", "derived_quantities", "PERCENTILES"]

@@ -121,24 +121,6 @@ def _print_dof(model: Model) -> None:
         print(f"    {line}")
 
 
-def _spec_of(path: Path) -> str | None:
-    """The model specification a fit file names, or None (a flat map of values)."""
-    from ..fitting.params_io import read_json
-
-    data = read_json(path, "fit file")
-    if not isinstance(data, dict):
-        return None
-    spec, model = data.get("model_spec"), data.get("model")
-    if spec is not None and not isinstance(spec, str):
-        raise InputError(f"{path}: `model_spec`: expected a string such as \"fixed,p1\", "
-                         f"found {spec!r}")
-    if spec:
-        return spec
-    if isinstance(model, list) and model and all(isinstance(m, str) for m in model):
-        return ",".join(model)
-    return None
-
-
 def _assignments(items: list[str]) -> dict[str, float]:
     out, problems = {}, []
     for item in items:
@@ -160,7 +142,7 @@ def run(args: argparse.Namespace) -> int:
     from derive.export_c import c_export_files, export_c, has_c_compiler
 
     from ..data.models import BASELINE
-    from ..fitting.params_io import fit_notes, read_params
+    from ..fitting.record import fit_notes, fit_spec, read_params
 
     if not args.out and not args.fmu and not args.basilisk:
         raise InputError("nothing to write: give `--out DIR` for C sources, `--fmu OUT.fmu` "
@@ -182,7 +164,7 @@ def run(args: argparse.Namespace) -> int:
     for note in fit_notes(args.fit, force=args.force, what="parameter file"):
         print(f"warning: {note}", file=sys.stderr)
     values = read_params(args.fit) | _assignments(args.set)
-    spec = args.model or _spec_of(Path(args.fit)) or BASELINE
+    spec = args.model or fit_spec(args.fit) or BASELINE
     outputs = Outputs(overwrite=args.overwrite, inputs=[args.fit])
     outputs.folder("--out", args.out, [*c_export_files(args.name).values(), "simulate"])
     outputs.file("--fmu", args.fmu).file("--basilisk", args.basilisk).check()

@@ -4,7 +4,7 @@ from __future__ import annotations
 
 import argparse
 
-from ..outputs import Outputs, json_text
+from ..outputs import Outputs
 from ._cases import add_strict, load_cases
 from ._cases import positive_hz as _positive_hz
 
@@ -34,7 +34,10 @@ def add_parser(sub: argparse._SubParsersAction) -> None:
                         "(a transducer that is not zeroed or drifts); default: none")
     p.add_argument("--json", dest="json_out", default=None, help="write the result as JSON")
     p.add_argument("--plot", default=None, help="write the fit plots (PNG) of the first case")
-    p.add_argument("--report", action="store_true", help="print the full text fit report")
+    p.add_argument("--report", nargs="?", const="-", default=None, metavar="FILE.md",
+                   help="print the full text fit report; with a file name, write the report "
+                        "as Markdown there instead (with the provenance: versions, date, "
+                        "each data file's SHA-256, the options)")
     p.add_argument("--motion-band", type=_positive_hz, default=None, metavar="HZ",
                    help="highest frequency of the carriage motion (Hz): sets the estimated "
                         "carriage spline's knot spacing and the filtered input's displacement "
@@ -45,6 +48,26 @@ def add_parser(sub: argparse._SubParsersAction) -> None:
     p.set_defaults(run=run)
 
 
+#: Parsed options that are not options of the fit (the command's wiring).
+_NOT_OPTIONS = ("run", "command")
+
+
+def _report_file(args: argparse.Namespace) -> str | None:
+    """The Markdown report file of ``--report FILE.md`` (None: print, or no report)."""
+    from pathlib import Path
+
+    from analogs.errors import InputError
+
+    report = args.report
+    if report in (None, "-"):
+        return None
+    if Path(report).suffix.lower() == ".toml":  # `--report A1.toml`: the case, taken by --report
+        raise InputError(f"--report {report}: a case file where the report file was expected; "
+                         "give the report a .md name (`--report A1_fit.md`), or put `--report` "
+                         "after the case files")
+    return report
+
+
 def run(args: argparse.Namespace) -> int:
     import sys
 
@@ -52,10 +75,13 @@ def run(args: argparse.Namespace) -> int:
     from ..fitting.measurement import ChannelOffsets
     from ..fitting.nlp import fit
     from ..fitting.problem import FitProblem
+    from ..fitting.record import fit_json, fit_record, report_markdown
     from ..fitting.transcription import Collocation, MultipleShooting
 
+    report_file = _report_file(args)
     outputs = Outputs(overwrite=args.overwrite, inputs=args.cases)
-    outputs.file("--json", args.json_out).file("--plot", args.plot).check()
+    outputs.file("--json", args.json_out).file("--plot", args.plot)
+    outputs.file("--report", report_file).check()
     cases, notes = load_cases(args.cases, prediction=True, strict=args.strict,
                               motion_band_hz=args.motion_band)
     for w in notes:  # before the fit, which starts from [prediction]
@@ -68,7 +94,8 @@ def run(args: argparse.Namespace) -> int:
     problem = FitProblem.build(cases, model, input=mode, measurement=measurement)
     tr = MultipleShooting() if args.transcription == "multiple_shooting" else Collocation()
     result = fit(problem, transcription=tr, cost=args.cost)
-    if args.report or sys.stdout.isatty():
+    printed = args.report == "-" or (args.report is None and sys.stdout.isatty())
+    if printed:
         print(result.report())
     else:
         print(f"{result.verdict}, "
@@ -86,14 +113,19 @@ def run(args: argparse.Namespace) -> int:
         for case in cases:  # what loading did to the record ([test] resample_hz)
             for n in case.notes:
                 print(f"  note: {n}")
-    for w in result.warnings:
-        print(f"warning: {w}", file=sys.stderr)
+    if not (printed and sys.stdout.isatty()):  # on a terminal the report holds them
+        for w in result.warnings:
+            print(f"warning: {w}", file=sys.stderr)
+    record = None
+    if args.json_out or report_file:
+        options = {k: v for k, v in vars(args).items() if k not in _NOT_OPTIONS}
+        record = fit_record(result, model_spec=args.model, options=options, command="slosh fit",
+                            warnings=notes)
     with outputs.writing() as paths:
         if args.json_out:
-            data = result.to_dict()
-            data["model_spec"] = spec
-            data["warnings"] = [*notes, *data.get("warnings", ())]
-            paths["--json"].write_text(json_text(data))
+            paths["--json"].write_text(fit_json(record))
+        if report_file:
+            paths["--report"].write_text(report_markdown(result, record))
         if args.plot:
             from ..fitting.plots import plot_fit
 

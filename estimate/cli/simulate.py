@@ -44,7 +44,7 @@ def run(args: argparse.Namespace) -> int:
     from ..data import load_case
     from ..data.experiment import experiment
     from ..data.models import BASELINE, model_from_spec
-    from ..fitting.params_io import fit_notes, fitted_initial_state, read_params
+    from ..fitting.record import fit_notes, fitted_initial_state, read_params
 
     outputs = Outputs(overwrite=args.overwrite, inputs=[args.case, args.params])
     outputs.file("--out", args.out).check()

@@ -41,7 +41,7 @@ from derive import derive
 
 from ..data.case import Case
 from ..data.models import model_for_case, model_from_spec, rig_values
-from ..fitting.params_io import read_json
+from ..inputs import load_json
 from .drives import LATERAL_FAMILIES, LateralDrive
 from .problem import MAX_SWING, DesignProblem
 from .report import drive_table, write_drive
@@ -102,7 +102,7 @@ def _spec(parameters: dict, where: str) -> str:
 def rivals_from_diagnosis(path: str | Path, case: Case) -> tuple[Rival, Rival]:
     """The baseline and final models of a diagnosis (the JSON of ``slosh diagnose``) on
     ``case``'s rig, with their estimates."""
-    data = read_json(path, "diagnosis file")
+    data = load_json(path, "a diagnosis file (JSON)")
     out = []
     for label in ("baseline", "final"):
         entry = data.get(label) if isinstance(data, dict) else None

@@ -1,4 +1,8 @@
-"""Reading parameter files: a flat JSON map, or the fit result ``slosh fit`` writes."""
+"""Reading fit records (the JSON ``slosh fit`` writes, :data:`~.writer.SCHEMA`) and parameter
+files (a flat JSON map of values): every command that takes a fit reads it here.
+
+A record written before the schema was versioned (no ``"schema"`` key: version 1, without
+provenance) still reads; :attr:`Fit.notes` says what it lacks."""
 
 from __future__ import annotations
 
@@ -12,13 +16,18 @@ import numpy as np
 
 from analogs.errors import InputError
 
-__all__ = ["Fit", "fit_notes", "read_fit", "read_params", "read_json", "fitted_initial_state"]
+__all__ = ["Fit", "fit_notes", "fit_spec", "fitted_initial_state", "read_fit", "read_json",
+           "read_params", "schema_version"]
+
+#: Two-sided 95 % normal quantile: the interval of a record that does not hold its own
+#: (version 1) is the estimate +/- this many standard errors.
+_Z95 = 1.959963984540054
 
 
 def read_json(path: str | Path, what: str) -> object:
     """JSON content of ``path``; errors name the file and say what it should be (a regular
     file within :data:`estimate.inputs.MAX_JSON_BYTES` bytes: :func:`estimate.inputs.load_json`)."""
-    from ..inputs import load_json
+    from ...inputs import load_json
 
     return load_json(path, f"a {what} (JSON)")
 
@@ -69,12 +78,15 @@ def fit_notes(path: str | Path, *, force: bool = False, what: str = "fit file") 
         When the file says the fit did not converge (``"converged": false``), unless
         ``force`` (``--force``): then a warning says it is used anyway.
     """
-    from .nlp import LOW_R_SQUARED
+    from ..nlp import LOW_R_SQUARED
 
     data = read_json(path, what)
     if not isinstance(data, dict):
         return []
     notes = []
+    if isinstance(data.get("parameters"), dict) and schema_version(data) == 1:
+        notes.append(f"{path}: a fit record written before records carried their provenance "
+                     "(no `schema`): the package version, date and data checksums are unknown")
     converged, status = data.get("converged"), data.get("status")
     if converged is False:
         what = (f"{path}: the fit did not converge (`converged: false`"
@@ -113,7 +125,48 @@ def fitted_initial_state(path: str | Path, case) -> dict[str, float]:
 
 @dataclass(frozen=True)
 class Fit:
-    """What Monte Carlo and export need from the JSON that ``slosh fit`` writes."""
+    """A fit record as the commands that take a fit read it (:func:`read_fit`).
+
+    Attributes
+    ----------
+    path : pathlib.Path or None
+        The file read.
+    model_spec : str
+        The specification of the fitted model (``"fixed,p1:nospring"``).
+    case : str or None
+        The case file a flat parameter record names, if any.
+    values, units, lower, upper : mapping
+        Every parameter's value, unit (SI) and bounds (+/-inf when open), by dotted name.
+    estimated : tuple of str
+        The estimated parameters (the others were fixed or follow them).
+    covariance_names : tuple of str
+        The estimates the covariance holds (those inside their bounds), in its order.
+    covariance : ndarray
+        Their covariance (units squared).
+    stderr : mapping
+        Standard error of each parameter (NaN when there is none: fixed, or at a bound).
+    intervals : mapping
+        95 % interval of each estimate, as the fit report gives it; for a version 1 record,
+        which holds none, the estimate +/- 1.96 standard errors.
+    derived : mapping
+        Derived quantities: ``(value, stderr, unit)`` (stderr NaN when there is none).
+    converged, status : bool or None, str or None
+        Whether IPOPT converged, and its status.
+    r_squared : float
+        NaN when the record does not give it.
+    information_criteria : mapping
+        ``aic``, ``bic`` and how they were computed (empty for a version 1 record).
+    cases : tuple of str
+        The case files fitted.
+    schema : int
+        The record's layout version (1: written before records carried provenance).
+    provenance : mapping or None
+        Versions, date, files with their SHA-256, options (None for a version 1 record).
+    notes : tuple of str
+        What the reader says about the file (an old layout, what it lacks).
+    data : mapping
+        The whole record as read.
+    """
 
     path: Path | None
     model_spec: str
@@ -125,6 +178,23 @@ class Fit:
     estimated: tuple[str, ...]
     covariance_names: tuple[str, ...]
     covariance: np.ndarray = field(repr=False)
+    stderr: Mapping[str, float] = field(default_factory=dict, repr=False)
+    intervals: Mapping[str, tuple[float, float]] = field(default_factory=dict, repr=False)
+    derived: Mapping[str, tuple[float, float, str]] = field(default_factory=dict, repr=False)
+    converged: bool | None = None
+    status: str | None = None
+    r_squared: float = math.nan
+    information_criteria: Mapping[str, Any] = field(default_factory=dict, repr=False)
+    cases: tuple[str, ...] = ()
+    schema: int = 1
+    provenance: Mapping[str, Any] | None = field(default=None, repr=False)
+    notes: tuple[str, ...] = ()
+    data: Mapping[str, Any] = field(default_factory=dict, repr=False)
+
+    @property
+    def name(self) -> str:
+        """A short label: the file's name, or ``"(fit)"``."""
+        return self.path.name if self.path is not None else "(fit)"
 
 
 def _is_number(v: Any) -> bool:
@@ -141,8 +211,34 @@ def _bound(entry: Mapping, key: str, default: float, where: str, problems: list[
     return float(v)
 
 
+def _optional_number(entry: Mapping, key: str, where: str, problems: list[str]) -> float:
+    """A number or null (NaN) at ``entry[key]``; absent is NaN."""
+    v = entry.get(key)
+    if v is None:
+        return math.nan
+    if not _is_number(v):
+        problems.append(f"`{where}.{key}`: expected a finite number or null, found {v!r}")
+        return math.nan
+    return float(v)
+
+
+def _interval(entry: Mapping, value: float, se: float, where: str, problems: list[str]
+              ) -> tuple[float, float]:
+    raw = entry.get("interval_95")
+    if raw is None:  # a version 1 record: the normal interval
+        return (value - _Z95 * se, value + _Z95 * se) if math.isfinite(se) else \
+            (math.nan, math.nan)
+    if not (isinstance(raw, list) and len(raw) == 2
+            and all(x is None or _is_number(x) for x in raw)):
+        problems.append(f"`{where}.interval_95`: expected [lower, upper] (numbers or null), "
+                        f"found {raw!r}")
+        return math.nan, math.nan
+    return tuple(math.nan if x is None else float(x) for x in raw)  # type: ignore[return-value]
+
+
 def _parameters(params: Mapping, problems: list[str]):
     values, units, lower, upper, estimated = {}, {}, {}, {}, []
+    stderr, intervals = {}, {}
     for name, entry in params.items():
         where = f"parameters.{name}"
         if not isinstance(entry, Mapping):
@@ -159,12 +255,51 @@ def _parameters(params: Mapping, problems: list[str]):
         units[name] = str(unit)
         lower[name] = _bound(entry, "lower", -math.inf, where, problems)
         upper[name] = _bound(entry, "upper", math.inf, where, problems)
+        stderr[name] = _optional_number(entry, "stderr", where, problems)
         flag = entry.get("estimated", False)
         if not isinstance(flag, bool):
             problems.append(f"`{where}.estimated`: expected true or false, found {flag!r}")
         elif flag:
             estimated.append(name)
-    return values, units, lower, upper, estimated
+            intervals[name] = _interval(entry, values[name], stderr[name], where, problems)
+    return values, units, lower, upper, estimated, stderr, intervals
+
+
+def _derived(data: Mapping, problems: list[str]) -> dict[str, tuple[float, float, str]]:
+    values, errors, units = (data.get(k) for k in ("derived", "derived_stderr", "derived_units"))
+    if values is None:
+        return {}
+    if not isinstance(values, Mapping):
+        problems.append(f"`derived`: expected an object of numbers, found {values!r}"[:300])
+        return {}
+    errors = errors if isinstance(errors, Mapping) else {}
+    units = units if isinstance(units, Mapping) else {}
+    out = {}
+    for k, v in values.items():
+        if not _is_number(v):
+            problems.append(f"`derived.{k}`: expected a finite number, found {v!r}")
+            continue
+        se = errors.get(k)
+        out[k] = (float(v), float(se) if _is_number(se) else math.nan, str(units.get(k, "")))
+    return out
+
+
+def schema_version(data: Mapping, problems: list[str] | None = None) -> int:
+    """The layout version of the fit record ``data``: 1 without ``"schema"`` (written before
+    records carried provenance), else the number after ``slosh-analogs/fit/``; a schema of
+    another kind is a problem (appended to ``problems``) and reads as the current one."""
+    from .writer import SCHEMA
+
+    raw = data.get("schema")
+    if raw is None:
+        return 1
+    head, _, number = str(raw).rpartition("/")
+    if not isinstance(raw, str) or head != SCHEMA.rpartition("/")[0] or not number.isdigit():
+        if problems is not None:
+            problems.append(f"`schema`: expected \"{SCHEMA}\" (a fit record of slosh-analogs), "
+                            f"found {raw!r}")
+        return int(SCHEMA.rpartition("/")[2])
+    return int(number)
 
 
 def _covariance(cov: Any, values: Mapping, problems: list[str]) -> tuple[tuple[str, ...], np.ndarray]:
@@ -200,14 +335,22 @@ def _covariance(cov: Any, values: Mapping, problems: list[str]) -> tuple[tuple[s
 
 
 def read_fit(path: str | Path) -> Fit:
-    """Read a fit result (the JSON of ``slosh fit``).
+    """Read a fit record (the JSON of ``slosh fit``), of any schema version.
 
     Raises
     ------
     InputError
         Naming the file and, for every problem, the key: missing keys, values of the wrong
         type, a covariance that is not square, names that are not parameters.
+
+    Examples
+    --------
+    >>> fit = read_fit("A1_fit.json")                        # doctest: +SKIP
+    >>> fit.model_spec, fit.values["p1.mass"], fit.intervals["p1.mass"]   # doctest: +SKIP
+    ('fixed,p1', 1.30015, (1.29589, 1.30442))
     """
+    from .writer import SCHEMA
+
     path = Path(path)
     data = read_json(path, "fit file")
     params = data.get("parameters") if isinstance(data, dict) else None
@@ -215,6 +358,7 @@ def read_fit(path: str | Path) -> Fit:
         raise InputError(f"{path}: expected a fit result (as `slosh fit --json` writes) with a "
                          "non-empty \"parameters\" object")
     problems: list[str] = []
+    schema = schema_version(data, problems)
     spec, model = data.get("model_spec"), data.get("model")
     if spec is not None and not isinstance(spec, str):
         problems.append(f"`model_spec`: expected a string such as \"fixed,p1\", found {spec!r}")
@@ -227,17 +371,63 @@ def read_fit(path: str | Path) -> Fit:
     if case is not None and not isinstance(case, str):
         problems.append(f"`case`: expected a string, found {case!r}")
         case = None
-    values, units, lower, upper, estimated = _parameters(params, problems)
+    values, units, lower, upper, estimated, stderr, intervals = _parameters(params, problems)
     names, matrix = _covariance(data.get("covariance"), values, problems)
+    derived = _derived(data, problems)
+    converged, status = data.get("converged"), data.get("status")
+    cases = data.get("cases")
+    cases = tuple(cases) if isinstance(cases, list) and all(isinstance(c, str) for c in cases) \
+        else ()
+    prov = data.get("provenance")
+    if prov is not None and not isinstance(prov, Mapping):
+        problems.append(f"`provenance`: expected an object, found {prov!r}"[:300])
+        prov = None
+    criteria = data.get("information_criteria")
     if problems:
         raise InputError(f"{path}: " + "; ".join(problems))
+    notes = []
+    if schema == 1:
+        notes.append(f"{path}: a fit record written before records carried their provenance "
+                     "(no `schema`): the package version, date and data checksums are unknown, "
+                     "and its 95 % intervals are the estimates +/- 1.96 standard errors")
+    elif schema > int(SCHEMA.rpartition("/")[2]):
+        notes.append(f"{path}: written by a newer slosh-analogs (schema {data['schema']}); "
+                     f"read as {SCHEMA}, keys this version does not know ignored")
     keep = [i for i, n in enumerate(names) if not _stream_lag(n)]  # marginal of the analog
     names, matrix = tuple(names[i] for i in keep), np.asarray(matrix)[np.ix_(keep, keep)]
-    values = {k: v for k, v in values.items() if not _stream_lag(k)}
     estimated = [n for n in estimated if not _stream_lag(n)]
-    for d in (units, lower, upper):
+    for d in (values, units, lower, upper, stderr, intervals):
         for k in [k for k in d if _stream_lag(k)]:
             del d[k]
     return Fit(path=path, model_spec=str(spec), case=case, values=values, units=units,
                lower=lower, upper=upper, estimated=tuple(estimated), covariance_names=names,
-               covariance=matrix)
+               covariance=matrix, stderr=stderr, intervals=intervals, derived=derived,
+               converged=converged if isinstance(converged, bool) else None,
+               status=status if isinstance(status, str) else None,
+               r_squared=float(data["r_squared"]) if _is_number(data.get("r_squared"))
+               else math.nan,
+               information_criteria=dict(criteria) if isinstance(criteria, Mapping) else {},
+               cases=cases, schema=schema, provenance=prov, notes=tuple(notes), data=data)
+
+
+def fit_spec(path: str | Path) -> str | None:
+    """The model specification the fit record ``path`` names (``model_spec``, else its
+    ``model`` list), or None for a flat map of parameter values.
+
+    Raises
+    ------
+    InputError
+        When ``model_spec`` is not a string.
+    """
+    data = read_json(path, "fit file")
+    if not isinstance(data, dict):
+        return None
+    spec, model = data.get("model_spec"), data.get("model")
+    if spec is not None and not isinstance(spec, str):
+        raise InputError(f"{path}: `model_spec`: expected a string such as \"fixed,p1\", "
+                         f"found {spec!r}")
+    if spec:
+        return spec
+    if isinstance(model, list) and model and all(isinstance(m, str) for m in model):
+        return ",".join(model)
+    return None
