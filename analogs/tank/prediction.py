@@ -109,6 +109,12 @@ Solver = Union[Exact, Ritz, FiniteElements, Legacy]
 METHODS = {"exact": Exact, "ritz": Ritz, "fem": FiniteElements, "legacy": Legacy}
 
 
+#: What the damping ratio of the higher modes is (the tank report's footnote and note).
+MODE1_DAMPING = ("the first mode's damping ratio: the SP-106 correlations are for the first "
+                 "mode, and the SLOSH code gives the same value to every mode; estimate a "
+                 "higher mode's damping from data")
+
+
 # -- results -------------------------------------------------------------------------------
 @dataclass(frozen=True)
 class SloshMode:
@@ -195,11 +201,19 @@ class TankPrediction:
             f"{'mode':>4} {'f [Hz]':>8} {'lambda R':>9} {'mass [kg]':>10} {'L [m]':>8} "
             f"{'hinge [m]':>10} {'wave/bob':>9} {'zeta [%]':>9}",
         ]
+        copied = False
         for m in self.modes:
+            mark = " *" if m.index > 1 and math.isfinite(m.damping_ratio) else ""
+            copied = copied or bool(mark)
             lines.append(f"{m.index:>4} {m.frequency_hz:8.4f} {m.lam * t.radius:9.5f} "
                          f"{m.mass:10.4f} {m.length:8.4f} {m.hinge_height:10.4f} "
-                         f"{m.amplitude_ratio:9.4f} {100 * m.damping_ratio:9.4f}")
+                         f"{m.amplitude_ratio:9.4f} {100 * m.damping_ratio:9.4f}{mark}")
         f = self.fixed_mass
+        lines += ["", "L: pendulum length; hinge: hinge height above the tank bottom; wave/bob: "
+                      "wave height at the wall over the bob's lateral amplitude; zeta: damping "
+                      "ratio (SP-106 wall boundary layer)"]
+        if copied:
+            lines.append("* the first mode's value (see the note below)")
         lines += ["", f"fixed mass {f.mass:.4f} kg at {f.height:.4f} m, pitch inertia "
                       f"{f.inertia:.5f} kg m^2 (frozen-liquid convention)"]
         lines += [f"note: {n}" for n in self.notes]
@@ -352,6 +366,8 @@ def predict(tank: Tank | Rectangular, *, fill: float | None = None, volume_fill:
     if diaphragm:
         notes.append("diaphragm: this is the free-surface prediction; a diaphragm raises the "
                      "frequency, lowers the slosh mass and adds damping - estimate them from data")
+    if len(out) > 1 and math.isfinite(zeta):
+        notes.append(f"modes 2 and up: {MODE1_DAMPING}")
     if not math.isfinite(zeta):
         what = "general profile" if tank.shape == "profile" else f"{tank.shape} tank"
         notes.append(f"no damping correlation for a {what}: damping_ratio is nan")

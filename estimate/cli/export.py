@@ -48,8 +48,9 @@ def add_parser(subparsers: argparse._SubParsersAction) -> None:
                         "tank bottom to the free surface (default 0,0,1)")
     p.add_argument("--model", default=None,
                    help="model specification, e.g. 'fixed,p1' (default: the fit's model_spec)")
-    p.add_argument("--integrator", choices=("rk4", "adaptive"), default="rk4",
-                   help="rk4 (fixed step; the only one that can be generated as C)")
+    p.add_argument("--integrator", choices=("rk4",), default="rk4",
+                   help="rk4, fixed step (the only integrator that can be generated as C; "
+                        "CasADi's adaptive CVODES cannot); --substeps refines it")
     p.add_argument("--substeps", type=int, default=1, help="RK4 substeps per step (default 1)")
     p.add_argument("--interface", choices=("rig", "vehicle"), default="rig",
                    help="rig: lateral rig inputs rig.x, rig.x_dot, rig.x_ddot (default); "
@@ -149,9 +150,6 @@ def run(args: argparse.Namespace) -> int:
                          "and/or `--basilisk OUT.py`")
     if (args.tank_position or args.tank_axis) and not args.basilisk:
         raise InputError("`--tank-position` and `--tank-axis` place the tank for `--basilisk`")
-    if args.integrator != "rk4":
-        raise InputError("only `--integrator rk4` can be exported: CasADi's cvodes integrator "
-                         "cannot be generated as C")
     if args.planar and args.interface != "vehicle":
         raise InputError("`--planar` applies to `--interface vehicle` only")
     if args.basilisk and not args.basilisk.endswith(".py"):

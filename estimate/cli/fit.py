@@ -18,16 +18,26 @@ def add_parser(sub: argparse._SubParsersAction) -> None:
                     "physical parameters, per-case crank corrections) with IPOPT.")
     p.add_argument("cases", nargs="+", help="test case files (TOML)")
     p.add_argument("--model", default=None,
-                   help="model specification, e.g. 'fixed,p1,p2' or 'fixed,p1:quadratic' "
-                        "(default: fixed,p1 = fixed mass + pendulum with hinge spring and damper)")
+                   help="model specification: comma-separated `fixed` (fixed mass) and `pN`, "
+                        "N from 1 to 6 (pendulum of slosh mode N with hinge spring and damper; "
+                        "spherical on the spinning rig), each pendulum with optional modifiers "
+                        "`:nospring`, `:quadratic` (adds a quadratic damper), `:diaphragm` "
+                        "(adds a diaphragm spring); spinning rig: `rotor` or `rN`; e.g. "
+                        "'fixed,p1:nospring,p2:quadratic' (default: fixed,p1)")
     p.add_argument("--transcription", choices=("multiple_shooting", "collocation"),
-                   default="multiple_shooting")
+                   default="multiple_shooting",
+                   help="how the equations of motion enter the NLP, whose variables include "
+                        "the states at every sample: multiple shooting (continuity after an "
+                        "RK4 step per sample interval, default) or direct collocation (Radau "
+                        "degree-3 polynomials per sample interval)")
     p.add_argument("--input", choices=("estimated", "filtered"), default=None,
                    help="a measured carriage displacement is estimated with the parameters "
                         "(default) or smoothed and differentiated beforehand (default with "
                         "--cost abs)")
     p.add_argument("--cost", choices=("squared", "abs"), default="squared",
-                   help="sum of squared residuals (default) or the seed's sum((|E|-|S|)^2)")
+                   help="sum of squared force residuals (default), or 'abs': "
+                        "sum((|measured| - |simulated|)^2), sample by sample, blind to the "
+                        "force's sign (the classical workflow's cost; filtered input)")
     p.add_argument("--channel-offsets", choices=("none", "offset", "drift"), default="none",
                    help="estimate a zero offset ('offset') or an offset and a linear drift "
                         "('drift') of every measured channel with the parameters, per case "
