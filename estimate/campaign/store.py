@@ -29,6 +29,7 @@ from typing import Any
 from analogs.errors import InputError
 
 from ..inputs import load_json
+from ..version import package_version
 
 __all__ = ["MAX_ENTRY_BYTES", "STORE_SCHEMA", "Store", "outcome_checksum", "package_version",
            "task_key", "write_atomic"]
@@ -43,16 +44,6 @@ def outcome_checksum(outcome: Mapping[str, Any]) -> str:
     """SHA-256 of an outcome's canonical JSON (sorted keys; NaN written as ``NaN``)."""
     text = json.dumps(outcome, sort_keys=True, separators=(",", ":"), allow_nan=True)
     return hashlib.sha256(text.encode()).hexdigest()
-
-
-def package_version() -> str:
-    """The installed version of slosh-analogs ("unknown" when not installed)."""
-    from importlib.metadata import PackageNotFoundError, version
-
-    try:
-        return version("slosh-analogs")
-    except PackageNotFoundError:  # pragma: no cover - running from an uninstalled checkout
-        return "unknown"
 
 
 def task_key(task: str, files: Sequence[tuple[str | None, str | None]], model: str | None,

@@ -13,6 +13,8 @@ report.
   the schema was versioned still reads, with a note.
 * :func:`report_text` / :func:`report_markdown` - the fit report (``slosh fit --report``,
   ``slosh fit --report FILE.md``).
+* :func:`compare_fits` - two or more records side by side, with the differences in units of
+  their combined standard errors (``slosh compare``).
 
 Examples
 --------
@@ -23,7 +25,8 @@ Examples
 (1.2958, 1.3044)
 """
 
-from .provenance import file_sha256, package_version, provenance, versions
+from .compare import Comparison, Quantity, compare_fits
+from .provenance import file_sha256, provenance, versions
 from .reader import (
     Fit,
     fit_notes,
@@ -37,7 +40,7 @@ from .reader import (
 from .text import report_markdown, report_text
 from .writer import SCHEMA, fit_json, fit_record, information_criteria
 
-__all__ = ["SCHEMA", "Fit", "file_sha256", "fit_json", "fit_notes", "fit_record", "fit_spec",
-           "fitted_initial_state", "information_criteria", "package_version", "provenance",
-           "read_fit", "read_json", "read_params", "report_markdown", "report_text",
+__all__ = ["SCHEMA", "Comparison", "Fit", "Quantity", "compare_fits", "file_sha256", "fit_json",
+           "fit_notes", "fit_record", "fit_spec", "fitted_initial_state", "information_criteria",
+           "provenance", "read_fit", "read_json", "read_params", "report_markdown", "report_text",
            "schema_version", "versions"]

@@ -11,19 +11,11 @@ from collections.abc import Mapping, Sequence
 from pathlib import Path
 from typing import Any
 
-__all__ = ["file_sha256", "package_version", "provenance", "versions"]
+from ...version import package_version
+
+__all__ = ["file_sha256", "provenance", "versions"]
 
 _CHUNK = 1 << 20
-
-
-def package_version() -> str:
-    """The installed version of slosh-analogs (``"unknown"`` when not installed)."""
-    from importlib.metadata import PackageNotFoundError, version
-
-    try:
-        return version("slosh-analogs")
-    except PackageNotFoundError:  # pragma: no cover - running from an uninstalled checkout
-        return "unknown"
 
 
 def file_sha256(path: str | Path) -> str | None:

@@ -150,6 +150,9 @@ class Fit:
         which holds none, the estimate +/- 1.96 standard errors.
     derived : mapping
         Derived quantities: ``(value, stderr, unit)`` (stderr NaN when there is none).
+    derived_intervals : mapping
+        Their 95 % intervals (a version 1 record: +/- 1.96 standard errors; NaN where there
+        is no standard error).
     converged, status : bool or None, str or None
         Whether IPOPT converged, and its status.
     r_squared : float
@@ -181,6 +184,8 @@ class Fit:
     stderr: Mapping[str, float] = field(default_factory=dict, repr=False)
     intervals: Mapping[str, tuple[float, float]] = field(default_factory=dict, repr=False)
     derived: Mapping[str, tuple[float, float, str]] = field(default_factory=dict, repr=False)
+    derived_intervals: Mapping[str, tuple[float, float]] = field(default_factory=dict,
+                                                                 repr=False)
     converged: bool | None = None
     status: str | None = None
     r_squared: float = math.nan
@@ -222,16 +227,16 @@ def _optional_number(entry: Mapping, key: str, where: str, problems: list[str]) 
     return float(v)
 
 
-def _interval(entry: Mapping, value: float, se: float, where: str, problems: list[str]
+def _interval(raw: Any, value: float, se: float, key: str, problems: list[str]
               ) -> tuple[float, float]:
-    raw = entry.get("interval_95")
-    if raw is None:  # a version 1 record: the normal interval
+    """The 95 % interval ``raw`` found at ``key`` (``[lower, upper]``, null for none); a
+    version 1 record has none (``raw`` None): the estimate +/- 1.96 standard errors."""
+    if raw is None:
         return (value - _Z95 * se, value + _Z95 * se) if math.isfinite(se) else \
             (math.nan, math.nan)
     if not (isinstance(raw, list) and len(raw) == 2
             and all(x is None or _is_number(x) for x in raw)):
-        problems.append(f"`{where}.interval_95`: expected [lower, upper] (numbers or null), "
-                        f"found {raw!r}")
+        problems.append(f"`{key}`: expected [lower, upper] (numbers or null), found {raw!r}")
         return math.nan, math.nan
     return tuple(math.nan if x is None else float(x) for x in raw)  # type: ignore[return-value]
 
@@ -261,27 +266,33 @@ def _parameters(params: Mapping, problems: list[str]):
             problems.append(f"`{where}.estimated`: expected true or false, found {flag!r}")
         elif flag:
             estimated.append(name)
-            intervals[name] = _interval(entry, values[name], stderr[name], where, problems)
+            intervals[name] = _interval(entry.get("interval_95"), values[name], stderr[name],
+                                        f"{where}.interval_95", problems)
     return values, units, lower, upper, estimated, stderr, intervals
 
 
-def _derived(data: Mapping, problems: list[str]) -> dict[str, tuple[float, float, str]]:
-    values, errors, units = (data.get(k) for k in ("derived", "derived_stderr", "derived_units"))
+def _derived(data: Mapping, problems: list[str]
+             ) -> tuple[dict[str, tuple[float, float, str]], dict[str, tuple[float, float]]]:
+    """Derived quantities ``(value, stderr, unit)`` and their 95 % intervals."""
+    values, errors, units, intervals = (data.get(k) for k in (
+        "derived", "derived_stderr", "derived_units", "derived_interval_95"))
     if values is None:
-        return {}
+        return {}, {}
     if not isinstance(values, Mapping):
         problems.append(f"`derived`: expected an object of numbers, found {values!r}"[:300])
-        return {}
+        return {}, {}
     errors = errors if isinstance(errors, Mapping) else {}
     units = units if isinstance(units, Mapping) else {}
-    out = {}
+    out, bands = {}, {}
     for k, v in values.items():
         if not _is_number(v):
             problems.append(f"`derived.{k}`: expected a finite number, found {v!r}")
             continue
         se = errors.get(k)
         out[k] = (float(v), float(se) if _is_number(se) else math.nan, str(units.get(k, "")))
-    return out
+        raw = intervals.get(k) if isinstance(intervals, Mapping) else None
+        bands[k] = _interval(raw, *out[k][:2], f"derived_interval_95.{k}", problems)
+    return out, bands
 
 
 def schema_version(data: Mapping, problems: list[str] | None = None) -> int:
@@ -373,7 +384,7 @@ def read_fit(path: str | Path) -> Fit:
         case = None
     values, units, lower, upper, estimated, stderr, intervals = _parameters(params, problems)
     names, matrix = _covariance(data.get("covariance"), values, problems)
-    derived = _derived(data, problems)
+    derived, derived_intervals = _derived(data, problems)
     converged, status = data.get("converged"), data.get("status")
     cases = data.get("cases")
     cases = tuple(cases) if isinstance(cases, list) and all(isinstance(c, str) for c in cases) \
@@ -402,6 +413,7 @@ def read_fit(path: str | Path) -> Fit:
     return Fit(path=path, model_spec=str(spec), case=case, values=values, units=units,
                lower=lower, upper=upper, estimated=tuple(estimated), covariance_names=names,
                covariance=matrix, stderr=stderr, intervals=intervals, derived=derived,
+               derived_intervals=derived_intervals,
                converged=converged if isinstance(converged, bool) else None,
                status=status if isinstance(status, str) else None,
                r_squared=float(data["r_squared"]) if _is_number(data.get("r_squared"))

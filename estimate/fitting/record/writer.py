@@ -59,6 +59,15 @@ def _noise_dict(carriage: Any, noise: Any) -> dict[str, Any] | None:
     return out
 
 
+def _derived_intervals(result: "FitResult") -> dict[str, list[float | None]]:
+    """95 % interval of each derived quantity (delta method, t quantile of the fit's degrees
+    of freedom, as the estimates'); null where there is no standard error."""
+    from scipy.stats import t as student
+
+    q = float(student.ppf(0.975, result.dof))
+    return {k: [_number(v - q * se), _number(v + q * se)] for k, (v, se) in result.derived.items()}
+
+
 def _parameters(result: "FitResult") -> dict[str, Any]:
     params: dict[str, Any] = {}
     free = result.free
@@ -139,6 +148,7 @@ def fit_record(result: "FitResult", *, model_spec: str | None = None,
         "derived": {k: v for k, (v, _) in result.derived.items()},
         "derived_stderr": {k: _number(se) for k, (_, se) in result.derived.items()},
         "derived_units": dict(result.derived_units),
+        "derived_interval_95": _derived_intervals(result),
         "cost": result.cost,
         "rms_residual": result.rms_residual,
         "r_squared": result.r_squared,
