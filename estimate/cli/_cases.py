@@ -9,7 +9,7 @@ from typing import TYPE_CHECKING
 if TYPE_CHECKING:  # the parser of every command imports this module: load nothing yet
     from ..data import Case
 
-__all__ = ["add_force", "add_strict", "load_cases", "positive_hz"]
+__all__ = ["add_force", "add_strict", "assignments", "load_cases", "positive_hz"]
 
 
 def add_strict(parser) -> None:
@@ -70,3 +70,27 @@ def positive_hz(text: str) -> float:
     if not (math.isfinite(value) and value > 0):
         raise argparse.ArgumentTypeError(f"expected a positive frequency in Hz, found {text!r}")
     return value
+
+
+def assignments(items: Sequence[str]) -> dict[str, float]:
+    """Values of ``--set NAME=VALUE`` options by name.
+
+    Raises
+    ------
+    InputError
+        Naming every item that is not ``NAME=NUMBER``.
+    """
+    from analogs.errors import InputError
+
+    out, problems = {}, []
+    for item in items:
+        name, sep, value = item.partition("=")
+        try:
+            if not sep:
+                raise ValueError
+            out[name.strip()] = float(value)
+        except ValueError:
+            problems.append(f"`--set {item}`: expected NAME=NUMBER")
+    if problems:
+        raise InputError("; ".join(problems))
+    return out

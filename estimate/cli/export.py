@@ -18,7 +18,7 @@ from analogs.errors import InputError
 from analogs.vehicle import VehicleFrame, axisymmetric, degrees_of_freedom
 
 from ..outputs import Outputs
-from ._cases import add_force
+from ._cases import add_force, assignments
 
 __all__ = ["add_parser", "run", "export_model"]
 
@@ -122,21 +122,6 @@ def _print_dof(model: Model) -> None:
         print(f"    {line}")
 
 
-def _assignments(items: list[str]) -> dict[str, float]:
-    out, problems = {}, []
-    for item in items:
-        name, sep, value = item.partition("=")
-        try:
-            if not sep:
-                raise ValueError
-            out[name.strip()] = float(value)
-        except ValueError:
-            problems.append(f"`--set {item}`: expected NAME=NUMBER")
-    if problems:
-        raise InputError("; ".join(problems))
-    return out
-
-
 def run(args: argparse.Namespace) -> int:
     """Run ``slosh export``; returns the exit status."""
     from derive import derive
@@ -161,7 +146,7 @@ def run(args: argparse.Namespace) -> int:
                          "sources without one")
     for note in fit_notes(args.fit, force=args.force, what="parameter file"):
         print(f"warning: {note}", file=sys.stderr)
-    values = read_params(args.fit) | _assignments(args.set)
+    values = read_params(args.fit) | assignments(args.set)
     spec = args.model or fit_spec(args.fit) or BASELINE
     outputs = Outputs(overwrite=args.overwrite, inputs=[args.fit])
     outputs.folder("--out", args.out, [*c_export_files(args.name).values(), "simulate"])
