@@ -69,7 +69,11 @@ def task_key(task: str, files: Sequence[tuple[str | None, str | None]], model: s
 
 def write_atomic(path: str | os.PathLike[str], data: bytes) -> Path:
     """Write ``data`` to ``path`` through a hidden temporary file in the same folder and a
-    rename: readers see the old file or the new one, never a part."""
+    rename: readers see the old file or the new one, never a part. The file gets the mode
+    of any other output (:func:`estimate.outputs.output_mode`: 0644 under umask 022), not
+    the temporary file's 0600."""
+    from ..outputs import output_mode
+
     path = Path(path)
     fd, tmp = tempfile.mkstemp(dir=path.parent, prefix=f".{path.name}.", suffix=".tmp")
     try:
@@ -77,6 +81,7 @@ def write_atomic(path: str | os.PathLike[str], data: bytes) -> Path:
             fh.write(data)
             fh.flush()
             os.fsync(fh.fileno())
+        os.chmod(tmp, output_mode())
         os.replace(tmp, path)
     except BaseException:
         Path(tmp).unlink(missing_ok=True)
