@@ -235,7 +235,7 @@ def check_drive_frequency(time: ArrayLike, force: ArrayLike, drive_frequency: fl
                           max_frequency: float | None = None) -> DriveCheck:
     """Check that the dominant force frequency matches the drive frequency.
 
-    The seed's workflow verified that the frequency seen by a spectrum analyser and the measured
+    Classical slosh tests verify that the frequency seen by a spectrum analyser and the measured
     test frequency agree within about 1.5%.
 
     Parameters
