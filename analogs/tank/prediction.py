@@ -49,11 +49,16 @@ class Ritz:
     """Ritz with m = 1 solid harmonics up to ``degree`` (exponential convergence up to half
     full spheres, algebraic above: use ``degree >= 80`` beyond 85 % fill)."""
 
+    #: Highest degree of the solid harmonics.
     degree: int = 60
+    #: Relative cut-off of small singular values of the Ritz matrices (their conditioning
+    #: grows with the degree).
     rcond: float = 1e-12
+    #: The solver's name (``predict(method=...)``, reports).
     name: str = "ritz"
 
     def solve(self, tank: Tank, depth: float, n_modes: int) -> RawModes:
+        """The first ``n_modes`` lateral modes of ``tank`` filled to ``depth`` (m)."""
         return _ritz.solve(tank, depth, degree=self.degree, n_modes=n_modes, rcond=self.rcond)
 
 
@@ -65,9 +70,11 @@ class FiniteElements:
     degree: int = 7
     layers: int = 7
     ratio: float = 0.2
+    #: The solver's name (``predict(method=...)``, reports).
     name: str = "fem"
 
     def solve(self, tank: Tank, depth: float, n_modes: int) -> RawModes:
+        """The first ``n_modes`` lateral modes of ``tank`` filled to ``depth`` (m)."""
         return _fem.solve(tank, depth, degree=self.degree, layers=self.layers,
                           ratio=self.ratio, n_modes=n_modes)
 
@@ -79,9 +86,11 @@ class Legacy:
 
     n_poly: int = 5
     n_bessel: int = 5
+    #: The solver's name (``predict(method=...)``, reports).
     name: str = "legacy"
 
     def solve(self, tank: Tank, depth: float, n_modes: int) -> RawModes:
+        """The first ``n_modes`` lateral modes of ``tank`` filled to ``depth`` (m)."""
         return _legacy.solve(tank, depth, n_poly=self.n_poly, n_bessel=self.n_bessel,
                              n_modes=n_modes)
 
@@ -91,9 +100,11 @@ class Exact:
     """Converged answer: Ritz where it converges fast (spheres up to 75 % depth, shallow
     cylinders), graded finite elements elsewhere."""
 
+    #: The solver's name (``predict(method=...)``, reports).
     name: str = "exact"
 
     def choose(self, tank: Tank, depth: float) -> Ritz | FiniteElements:
+        """The solver that converges fast for ``tank`` filled to ``depth`` (m)."""
         if isinstance(tank, Sphere) and depth <= 1.5 * tank.radius:
             return Ritz(degree=40 if depth <= tank.radius else 60)
         if isinstance(tank, Cylinder) and depth <= 2.0 * tank.radius:
@@ -101,6 +112,7 @@ class Exact:
         return FiniteElements()
 
     def solve(self, tank: Tank, depth: float, n_modes: int) -> RawModes:
+        """The first ``n_modes`` lateral modes of ``tank`` filled to ``depth`` (m)."""
         return self.choose(tank, depth).solve(tank, depth, n_modes)
 
 
@@ -120,7 +132,7 @@ MODE1_DAMPING = ("the first mode's damping ratio: the SP-106 correlations are fo
 class SloshMode:
     """One lateral slosh mode as a pendulum. SI units; heights from the tank bottom."""
 
-    index: int
+    index: int  #: mode number, 1 for the first
     frequency_hz: float  #: natural frequency, Hz
     lam: float  #: eigenvalue omega^2 / g, 1/m
     mass: float  #: pendulum (slosh) mass, kg
@@ -147,7 +159,40 @@ class FixedMassPrediction:
 
 @dataclass(frozen=True)
 class TankPrediction:
-    """Predicted analog parameters for a tank, fill and liquid (see :func:`predict`)."""
+    """Predicted analog parameters for a tank, fill and liquid (see :func:`predict`).
+
+    Attributes
+    ----------
+    tank : Tank or Rectangular
+        The tank geometry.
+    liquid : Liquid
+        Density and kinematic viscosity.
+    gravity : float
+        Axial acceleration, m/s^2.
+    depth : float
+        Liquid depth, m.
+    fill_fraction, volume_fraction : float
+        Depth over the tank's height, liquid volume over the tank's volume.
+    liquid_mass : float
+        Mass of the liquid, kg.
+    liquid_cg_height : float
+        Height of the liquid's centre of mass above the tank bottom, m.
+    method, solver : str
+        The method asked for (``"exact"``, ``"legacy"``, ...) and the solver it used
+        (``"ritz"``, ``"fem"``, ``"closed form"``).
+    modes : tuple of SloshMode
+        The lateral slosh modes kept, as pendulums.
+    fixed_mass : FixedMassPrediction
+        The liquid that does not slosh: mass, height and pitch inertia.
+    diaphragm : bool
+        The tank has a diaphragm (the prediction is still the free-surface one).
+    size : int
+        Unknowns of the modal analysis (0 in closed form).
+    seconds : float
+        Time the modal analysis took, s.
+    notes : tuple of str
+        What the prediction says about itself (validity, the higher modes' damping, ...).
+    """
 
     tank: Tank
     liquid: Liquid
@@ -223,8 +268,8 @@ class TankPrediction:
         """A ready analog model: rig + fixed mass + one damped pendulum per kept mode.
 
         Predicted values are the defaults; the pendulum length is bounded to
-        ``(1 -+ bound_fraction)`` times its prediction. The hinge damper coefficient is
-        ``c = 2 zeta m L^2 omega`` (N m s/rad).
+        ``(1 -+ bound_fraction)`` times its prediction (``bound_fraction`` default 0.2).
+        The hinge damper coefficient is ``c = 2 zeta m L^2 omega`` (N m s/rad).
 
         Examples
         --------

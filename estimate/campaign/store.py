@@ -151,7 +151,7 @@ class Store:
         return write_atomic(self._path(key), json.dumps(entry, indent=1, allow_nan=True).encode())
 
     def seconds(self, key: str) -> float | None:
-        """How long the stored task took (s), or None."""
+        """How long the task stored under ``key`` took (s), or None."""
         try:
             return float(self._entry(key)["seconds"])
         except (OSError, ValueError, KeyError, TypeError, InputError):

@@ -50,7 +50,8 @@ def quantity_column(name: str, unit: str, stat: str = "") -> str:
 
 @dataclass(frozen=True)
 class CampaignTable:
-    """Columns (name, type) and rows (dicts by column name; missing values are None)."""
+    """``columns`` (name, type) and ``rows`` (dicts by column name; missing values are
+    None)."""
 
     columns: tuple[tuple[str, type], ...]
     rows: tuple[dict[str, Any], ...]
@@ -142,7 +143,7 @@ def _group_verdict(run: CampaignRun, members: tuple[str, ...]) -> str:
 
 
 def campaign_table(run: CampaignRun) -> CampaignTable:
-    """The table of a campaign run (see the module docstring for its layout)."""
+    """The table of the campaign ``run`` (see the module docstring for its layout)."""
     c = run.campaign
     flagged = {o.record: o for o in run.outliers}
     units: dict[str, str] = {}

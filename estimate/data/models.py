@@ -119,7 +119,8 @@ def _number_of(name: str, letter: str) -> int | None:
 
 
 def model_from_spec(spec: str, case: Case, *, option: str = "--model") -> Model:
-    """Build a model from a comma-separated specification such as ``"fixed,p1,p2"``.
+    """Build a model from a comma-separated specification ``spec`` such as
+    ``"fixed,p1,p2"``, on the rig of ``case``.
 
     Tokens: ``fixed`` (FixedMass); ``pN`` with N from 1 to ``MAX_MODES`` (6: the modes the
     tank prediction gives initial values for) (Pendulum with HingeSpring and HingeDamper;

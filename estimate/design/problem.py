@@ -73,6 +73,13 @@ class DesignProblem:
     record and ``rms`` that record's RMS per channel (the noise of a new record grows with
     its RMS, never below ``noise``); ``displacement_noise`` (m) that of the carriage
     displacement (lateral rig).
+
+    ``case``, ``model`` and its ``derived`` form are those of the next record;
+    ``limits`` the rig's (``[rig.limits]``); ``targets`` the parameters the design is for,
+    scored by ``criterion`` (``"D"`` or ``"A"``); ``channels`` the measured channels;
+    ``duration`` (s) and ``rate`` (Hz) the record's; ``max_swing`` the largest predicted
+    swing (rad); ``frequencies`` the fitted modes' (Hz, by component); ``goal`` the relative
+    interval half-width asked for; ``fit_path`` the fit read; ``notes`` what building said.
     """
 
     case: Case

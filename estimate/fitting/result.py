@@ -65,7 +65,40 @@ class FitResult:
     also on samples left out by zero weights) and the (filtered) measured force; for a
     multi-channel case (spinning rig) both are ``samples x channels`` arrays, columns
     named by ``channels`` (N and N m);
-    ``history`` the estimates at every IPOPT iteration.
+    ``history`` the estimates at every IPOPT iteration and ``cost_history`` the cost there.
+
+    Attributes
+    ----------
+    problem : FitProblem
+        What was fitted.
+    rms_residual, r_squared : float
+        RMS residual over the fitted samples (N; scaled for several channels) and the
+        share of the measurement's variance the model explains.
+    n_samples, iterations : int
+        Fitted samples, IPOPT iterations.
+    seconds : float
+        Wall time of the fit, s.
+    converged, status : bool, str
+        Whether IPOPT converged, and its status (``"Solve_Succeeded"``).
+    warnings : tuple of str
+        What the fit says about itself (bounds reached, a low R^2, ...).
+    identifiability : Identifiability
+        The scaled sensitivity's conditioning and the confounded groups.
+    derived : dict
+        Derived quantities ``(value, stderr)`` of case 0 (:func:`derived_quantities`).
+    cost_kind, transcription : str
+        The cost (``"squared"``, ``"abs"``) and the transcription used.
+    dof : int
+        Degrees of freedom of the residual (also ``residual_variance``, below).
+    initial_states : tuple of dict
+        Per case, the state at the first sample (see ``initial_state_kinds``).
+    bound_stderr : ndarray or None
+        Per estimate at a bound, the spread the data allow away from it (see ``at_bound``).
+    carriage_coefficients : tuple
+        Per case, the estimated carriage spline's coefficients (see ``states``).
+    covariance_kind : str
+        ``"robust"`` or ``"gauss-newton"``: which covariance ``covariance`` is (see
+        ``robust_covariance`` and ``gauss_newton_covariance``).
     """
 
     problem: "FitProblem" = field(repr=False)
@@ -209,7 +242,7 @@ class FitResult:
         return r / s if r.ndim == 2 else r / s[0]
 
     def channel(self, name: str, case: int = 0) -> tuple[np.ndarray, np.ndarray]:
-        """``(measured, residual)`` of one fitted channel of ``case`` (N or N m)."""
+        """``(measured, residual)`` of the fitted channel ``name`` of ``case`` (N or N m)."""
         names = self.channels[case] if self.channels else ("force_x",)
         if name not in names:
             raise UnknownNameError(f"{name!r} was not fitted; fitted channels: {', '.join(names)}")
@@ -269,9 +302,11 @@ class FitResult:
         return c
 
     def interval(self, name: str, level: float = 0.95) -> tuple[float, float]:
-        """Wald interval from the Gauss-Newton covariance (t distribution); for an estimate
-        at a bound the one-sided interval from the bound (:meth:`one_sided_limit`), up to
-        the other bound when the data do not determine it."""
+        """The ``level`` (default 0.95) interval of the estimate ``name``: the Wald interval
+        from :attr:`stderr` (the covariance ``covariance_kind`` names; t distribution); for
+        an estimate at a bound the one-sided interval from the bound
+        (:meth:`one_sided_limit`), up to the other bound when the data do not determine
+        it."""
         from scipy.stats import t as student
 
         i = self._index(name)
@@ -285,8 +320,8 @@ class FitResult:
         return float(self.values[i] - q * self.stderr[i]), float(self.values[i] + q * self.stderr[i])
 
     def one_sided_limit(self, name: str, level: float = 0.95) -> float | None:
-        """For an estimate at a bound: the one-sided ``level`` confidence limit away from
-        the bound (``bound +/- t_level * bound_stderr``), ``None`` when the data do not
+        """For an estimate ``name`` at a bound: the one-sided ``level`` confidence limit away
+        from the bound (``bound +/- t_level * bound_stderr``), ``None`` when the data do not
         determine it; raises for an estimate inside its bounds."""
         from scipy.stats import t as student
 

@@ -45,7 +45,8 @@ class Quantity:
     intervals: tuple[tuple[float, float], ...]
 
     def difference(self, i: int, j: int = 0) -> tuple[float, float, float]:
-        """``(value_i - value_j, combined standard error, z)``: the combined standard error
+        """``(value_i - value_j, combined standard error, z)`` of fits ``i`` and ``j``
+        (default 0, the reference): the combined standard error
         is ``sqrt(se_i^2 + se_j^2)`` (independent fits), ``z`` the difference over it (NaN
         when either fit lacks the value or its standard error)."""
         d = self.values[i] - self.values[j]
@@ -56,8 +57,21 @@ class Quantity:
 
 @dataclass(frozen=True)
 class Comparison:
-    """The result of :func:`compare_fits`: the fits, their labels and the quantities, each
-    with its differences from the first fit (:meth:`Quantity.difference`)."""
+    """The result of :func:`compare_fits`.
+
+    Attributes
+    ----------
+    fits : tuple of Fit
+        The fit records, the reference first.
+    labels : tuple of str
+        Their labels in the table (the files' stems).
+    quantities : tuple of Quantity
+        Every estimate and derived quantity, each with its differences from the first fit
+        (:meth:`Quantity.difference`).
+    notes : tuple of str
+        What the table's reader should know (the same data files, different models, old
+        records).
+    """
 
     fits: tuple[Fit, ...] = field(repr=False)
     labels: tuple[str, ...]
@@ -207,9 +221,9 @@ def _same_records(fits: Sequence[Fit]) -> bool:
 
 
 def compare_fits(fits: Sequence[Fit]) -> Comparison:
-    """Compare two or more fit records (:func:`~estimate.fitting.record.read_fit`): every
-    parameter estimated by any of them and every derived quantity, in the order they first
-    appear, with each fit's difference from the first.
+    """Compare two or more fit records ``fits`` (:func:`~estimate.fitting.record.read_fit`):
+    every parameter estimated by any of them and every derived quantity, in the order they
+    first appear, with each fit's difference from the first.
 
     Raises
     ------

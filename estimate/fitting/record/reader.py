@@ -25,7 +25,8 @@ _Z95 = 1.959963984540054
 
 
 def read_json(path: str | Path, what: str) -> object:
-    """JSON content of ``path``; errors name the file and say what it should be (a regular
+    """JSON content of ``path``, a ``what`` (``"fit file"``); errors name the file and say
+    what it should be (a regular
     file within :data:`estimate.inputs.MAX_JSON_BYTES` bytes: :func:`estimate.inputs.load_json`)."""
     from ...inputs import load_json
 
@@ -70,7 +71,7 @@ def _stream_lag(name: str) -> bool:
 
 def fit_notes(path: str | Path, *, force: bool = False, what: str = "fit file") -> list[str]:
     """Warnings about the fit result ``path`` before a command uses it; a flat map of values
-    gives none.
+    gives none. ``what`` names the file in messages (``"parameter file"``).
 
     Raises
     ------
@@ -346,7 +347,7 @@ def _covariance(cov: Any, values: Mapping, problems: list[str]) -> tuple[tuple[s
 
 
 def read_fit(path: str | Path) -> Fit:
-    """Read a fit record (the JSON of ``slosh fit``), of any schema version.
+    """Read the fit record ``path`` (the JSON of ``slosh fit``), of any schema version.
 
     Raises
     ------

@@ -145,8 +145,9 @@ def _derived(result: "FitResult") -> list[tuple[str, str, str, str]]:
 
 
 def report_text(result: "FitResult") -> str:
-    """The text fit report: statistics (with AIC and BIC), estimates with intervals in
-    aligned columns, derived quantities, correlations, identifiability, notes, warnings."""
+    """The text report of the fit ``result``: statistics (with AIC and BIC), estimates with
+    intervals in aligned columns, derived quantities, correlations, identifiability, notes,
+    warnings."""
     robust = result.covariance_kind == "robust"
     lines = ["[[Fit statistics]]"]
     stats = _statistics(result) + _noise(result)
@@ -203,7 +204,8 @@ def _table(header: Sequence[str], rows: Sequence[Sequence[str]]) -> list[str]:
 
 
 def report_markdown(result: "FitResult", record: Mapping[str, Any]) -> str:
-    """The fit report as Markdown, with the provenance of ``record`` (the fit's JSON record,
+    """The report of the fit ``result`` as Markdown, with the provenance of ``record`` (the
+    fit's JSON record,
     :func:`~estimate.fitting.record.fit_record`): what was fitted, from which files (with
     their SHA-256) and with which versions, then the text report's sections as tables.
 

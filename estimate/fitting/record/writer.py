@@ -185,7 +185,7 @@ def fit_record(result: "FitResult", *, model_spec: str | None = None,
 
 
 def fit_json(record: Mapping[str, Any]) -> str:
-    """A fit record (:func:`fit_record`) as the strict JSON text written to a file
+    """The fit ``record`` (:func:`fit_record`) as the strict JSON text written to a file
     (:func:`estimate.outputs.json_text`: a value that is not finite is null and listed under
     ``"non_finite"``).
 
