@@ -26,17 +26,16 @@ Examples
 """
 
 from .compare import Comparison, Quantity, compare_fits
-from .provenance import file_sha256, provenance, versions
-from .reader import (
-    Fit,
+from .parameters import (
     fit_notes,
     fit_spec,
     fitted_initial_state,
-    read_fit,
     read_json,
     read_params,
     schema_version,
 )
+from .provenance import file_sha256, provenance, versions
+from .reader import Fit, read_fit
 from .text import report_markdown, report_text
 from .writer import SCHEMA, fit_json, fit_record, information_criteria
 
