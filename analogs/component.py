@@ -180,7 +180,7 @@ class Component:
     def derived_values(self, v: Mapping[str, Any], *, gravity: Any | None,
                        hinge_stiffness: Any, hinge_damping: Any) -> dict[str, Any]:
         """Quantities derived from the parameter values ``v`` (by local name), by the names
-        of :attr:`derived`.
+        of :attr:`derived`, given ``gravity``, ``hinge_stiffness`` and ``hinge_damping``.
 
         Values may be floats, NumPy arrays (one entry per Monte Carlo draw) or CasADi
         expressions (for delta-method standard errors), so implementations use arithmetic
@@ -255,6 +255,12 @@ class Attachment(Component):
 
     The ``name`` is the host's name; the element's parameters live in the host's
     namespace (``HingeSpring("p1")`` has ``p1.stiffness``).
+
+    Parameters
+    ----------
+    host : str
+        Name of the component whose hinge the element attaches to (``"p1"``), passed to
+        :class:`Component` as ``name``.
     """
 
     @property
@@ -294,8 +300,8 @@ class Rig(Component):
         return None
 
     def declare(self, k: "Declaration") -> None:
-        """Rigs add no generalized coordinates by default (the dry mass is added by
-        :meth:`declare_frame`)."""
+        """Rigs add no generalized coordinates by default through the declaration ``k``
+        (the dry mass is added by :meth:`declare_frame`)."""
 
     def declare_frame(self, f: "FrameDeclaration") -> None:
         """Set the tank frame's motion, the inputs and gravity on ``f``."""

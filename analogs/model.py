@@ -32,6 +32,11 @@ class Model:
         model = LateralRig() + FixedMass("fixed") + Pendulum("p1") + HingeDamper("p1")
 
     Adding returns a new model; the operands are not changed.
+
+    Parameters
+    ----------
+    components : iterable of Component, default ()
+        The rig and components, in order (``+`` builds the same).
     """
 
     def __init__(self, components: Iterable[Component] = ()) -> None:
@@ -59,7 +64,8 @@ class Model:
         return Model(c for c in self._components if c.name not in names)
 
     def replace(self, component: Component) -> "Model":
-        """A copy where the component of the same class and name is replaced."""
+        """A copy where the component of the same class and name as ``component`` is
+        replaced by it."""
         return Model(
             component if (type(c) is type(component) and c.name == component.name) else c
             for c in self._components

@@ -27,7 +27,9 @@ _MOUNT_PARAMS = {
 class Mounted(Component):
     """``component`` declared in its own tank frame ``M``, placed on the rig's tank frame
     ``T`` at ``mount_radius (cos(az) T.x + sin(az) T.y) + mount_height T.z`` (m), with
-    ``az = mount_azimuth`` (rad).
+    ``az = mount_azimuth`` (rad): ``mount_radius`` (m, from the ``T.z`` axis),
+    ``mount_azimuth`` (rad, from ``T.x`` toward ``T.y``) and ``mount_height`` (m, along
+    ``T.z``) are the mount's parameters (None: given later, as any parameter value).
 
     ``axis="parallel"`` (default): ``M`` is ``T`` turned by ``az`` about ``T.z`` (so the
     component's x axis points radially outward). ``axis="inward"``: ``M.z`` points from the
@@ -87,6 +89,8 @@ class Mounted(Component):
         return super().problems() + self.component.problems()
 
     def derived_values(self, v, **context):
+        """The wrapped component's derived quantities (``context``: the keywords of
+        :meth:`Component.derived_values`)."""
         return self.component.derived_values(v, **context)
 
     def declare(self, k: "Declaration") -> None:

@@ -62,11 +62,11 @@ class Parameter:
         return self.name.split(".", 1)[1]
 
     def with_default(self, value: float | None) -> "Parameter":
-        """Return a copy with another default value."""
+        """Return a copy whose default is ``value`` (None: required)."""
         return replace(self, default=None if value is None else float(value))
 
     def with_bounds(self, lower: float, upper: float) -> "Parameter":
-        """Return a copy with other bounds."""
+        """Return a copy with the bounds ``lower`` and ``upper`` (in its unit)."""
         return replace(self, lower=float(lower), upper=float(upper))
 
     def check(self, value: float) -> str | None:

@@ -127,8 +127,9 @@ class FreeSpacecraft(Rig):
 def body_angular_velocity(phi, theta, psi, phi_dot, theta_dot, psi_dot, spin_rate,
                           lib=np):
     """Angular velocity of the bus in bus axes (rad/s) from the :class:`FreeSpacecraft`
-    coordinates (rad) and rates (rad/s): the 1-2-3 rates relative to the reference frame
-    plus ``spin_rate`` (rad/s) about the inertial z axis.
+    coordinates ``phi``, ``theta``, ``psi`` (rad, the 1-2-3 angles) and their rates
+    ``phi_dot``, ``theta_dot``, ``psi_dot`` (rad/s) relative to the reference frame, plus
+    ``spin_rate`` (rad/s) about the inertial z axis.
 
     Returns the tuple ``(omega_x, omega_y, omega_z)``; ``lib`` supplies ``sin`` and
     ``cos`` (``numpy`` for arrays, ``casadi`` for symbolic use).

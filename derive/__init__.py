@@ -33,10 +33,14 @@ __all__ = [
 ]
 
 
-def export_fmu(*args, **kwargs):
-    from .fmu import export_fmu as _export_fmu
+def __getattr__(name: str):
+    """:func:`derive.fmu.export_fmu` (``derive.export_fmu``), imported when first used."""
+    if name == "export_fmu":
+        from .fmu import export_fmu
 
-    return _export_fmu(*args, **kwargs)
+        return export_fmu
+    raise AttributeError(f"module {__name__!r} has no attribute {name!r}")
 
 
-export_fmu.__doc__ = "Export an FMI 2.0 co-simulation FMU; see :func:`derive.fmu.export_fmu`."
+def __dir__() -> list[str]:
+    return sorted({*globals(), *__all__})

@@ -17,10 +17,13 @@ from analogs.parameter import Parameter
 
 __all__ = ["DerivedModel", "ParameterError", "OUTPUT_NAMES", "OUTPUT_UNITS"]
 
+#: The outputs of every derived model, in order: the transducer's force and torque about
+#: the tank origin in tank-frame components, then kinetic and potential energy.
 OUTPUT_NAMES = (
     "force_x", "force_y", "force_z", "torque_x", "torque_y", "torque_z",
     "kinetic_energy", "potential_energy",
 )
+#: SI unit of each of :data:`OUTPUT_NAMES`.
 OUTPUT_UNITS = ("N", "N", "N", "N m", "N m", "N m", "J", "J")
 
 
@@ -45,6 +48,27 @@ class DerivedModel:
       the tank origin (N m) that the transducer applies to the tank assembly, in tank-frame
       components (for a rigid tank, force = total mass x (acceleration - gravity)), then
       kinetic and potential energy (J).
+    - ``mass_matrix`` -> ``M(q, p)`` and ``forcing`` -> ``f(x, u, p, t)`` of
+      ``M qdd = f``, kept apart (no symbolic inverse).
+
+    Attributes
+    ----------
+    model : analogs.Model
+        The declared model.
+    coordinates : tuple of str
+        The generalized coordinates (``"p1.theta"``); the states are these then their rates.
+    inputs, input_units : tuple of str
+        The rig's input signals and their SI units.
+    parameter_names : tuple of str
+        The parameters in the order of ``p``.
+    measured : tuple of str
+        The outputs the rig's transducer measures.
+    dependencies : mapping
+        Per output, the parameters it depends on.
+    from_cache : bool
+        Whether the functions were loaded from the disk cache.
+    _memo : dict
+        Functions built from these (maps, steps), kept with them (:meth:`memoized`).
     """
 
     model: Model
@@ -69,9 +93,9 @@ class DerivedModel:
         return self._memo[key]
 
     def mapped(self, key: tuple, fn: ca.Function, n: int) -> ca.Function:
-        """``fn.map(n)``, kept with the model's functions under ``key`` (which must name
-        ``fn``): CasADi builds a map's sparsity patterns when it is created, milliseconds
-        for a long record, and a fit creates several."""
+        """``fn.map(n)`` (``n`` parallel evaluations), kept with the model's functions
+        under ``key`` (which must name ``fn``): CasADi builds a map's sparsity patterns when
+        it is created, milliseconds for a long record, and a fit creates several."""
         k = ("map", key, n)
         if k not in self._memo:
             maps = [m for m in self._memo if m[0] == "map"]
@@ -164,6 +188,7 @@ class DerivedModel:
         return vec
 
     def output_index(self, name: str) -> int:
+        """Position of the output ``name`` (``"force_x"``) in :data:`OUTPUT_NAMES`."""
         try:
             return OUTPUT_NAMES.index(name)
         except ValueError:

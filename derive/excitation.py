@@ -32,7 +32,8 @@ class Excitation:
         raise NotImplementedError
 
     def symbolic(self, t: ca.MX) -> ca.MX:
-        """Input values as a CasADi expression of time (a column of :attr:`size`)."""
+        """Input values as a CasADi expression of the time ``t`` (s; a column of
+        :attr:`size`)."""
         raise NotImplementedError
 
 
@@ -52,8 +53,8 @@ class NoExcitation(Excitation):
 
 @dataclass(frozen=True)
 class Sine(Excitation):
-    """``x = amplitude sin(2 pi frequency t + phase)``: amplitude (m), frequency (Hz),
-    phase (rad)."""
+    """``x = amplitude sin(2 pi frequency t + phase)``: ``amplitude`` (m), ``frequency``
+    (Hz), ``phase`` (rad, default 0)."""
 
     amplitude: float
     frequency: float

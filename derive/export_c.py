@@ -73,7 +73,22 @@ def c_functions(dm: DerivedModel, *, substeps: int = 1, name: str = "slosh_model
 
 @dataclass(frozen=True)
 class CExport:
-    """Files of an exported model (all in :attr:`folder`) and its interface order."""
+    """Files of an exported model (all in :attr:`folder`) and its interface order.
+
+    Attributes
+    ----------
+    folder : Path
+        The folder of the export.
+    name : str
+        The C symbol prefix.
+    header, sources, driver, makefile, parameters_csv : Path
+        The header, the C sources, the standalone driver, its Makefile and the CSV of the
+        parameters' values, units and descriptions.
+    states, inputs, parameters, outputs : tuple of str
+        The names in the order of the C arrays.
+    substeps : int
+        RK4 substeps per step of the generated integrator.
+    """
 
     folder: Path
     name: str
@@ -91,7 +106,8 @@ class CExport:
     def build(self, *, cc: str | None = None, extra_flags: tuple[str, ...] = ("-Werror",),
               executable: str = "simulate") -> Path:
         """Compile the standalone driver with ``cc`` (default: ``$CC``, ``cc`` or ``gcc``)
-        and :data:`CFLAGS` plus ``extra_flags``; returns the executable's path.
+        and :data:`CFLAGS` plus ``extra_flags`` into ``executable`` (a file name in
+        :attr:`folder`, default ``"simulate"``); returns the executable's path.
 
         Raises
         ------

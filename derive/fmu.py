@@ -104,6 +104,8 @@ def export_fmu(
         or hold it (0).
     name : str
         Model identifier (a C identifier).
+    description : str, optional
+        The FMU's description (default: the model and its parameters' source).
     stop_time : float, default 10
         Stop time of the default experiment (s).
     cc : str, optional

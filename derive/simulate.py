@@ -37,8 +37,10 @@ class RK4:
 
 @dataclass(frozen=True)
 class Adaptive:
-    """Variable-step integrator from SUNDIALS through CasADi (``"cvodes"`` BDF/Adams or
-    ``"idas"``) with relative and absolute tolerances."""
+    """Variable-step integrator from SUNDIALS through CasADi: ``method`` ``"cvodes"``
+    (BDF/Adams, default) or ``"idas"``, with relative and absolute tolerances ``rtol``
+    (default 1e-10) and ``atol`` (1e-12); ``options`` are passed on to CasADi's
+    ``integrator`` (e.g. ``{"max_num_steps": 10000}``)."""
 
     method: str = "cvodes"
     rtol: float = 1e-10
@@ -52,7 +54,8 @@ class Simulation:
 
     ``states`` has shape ``(len(time), nx)`` (coordinates in rad or m, then rates);
     ``outputs`` has shape ``(len(time), 8)`` in :data:`derive.OUTPUT_NAMES` order (N, N m, J);
-    ``inputs`` holds the excitation values used.
+    ``inputs`` holds the excitation values used. ``time`` is the grid (s);
+    ``state_names``, ``input_names`` and ``output_names`` name the columns.
     """
 
     time: np.ndarray
@@ -64,20 +67,21 @@ class Simulation:
     output_names: tuple[str, ...] = OUTPUT_NAMES
 
     def output(self, name: str) -> np.ndarray:
-        """One output channel (e.g. ``"force_x"``) on the time grid."""
+        """The output channel ``name`` (e.g. ``"force_x"``) on the time grid."""
         if name not in self.output_names:
             raise UnknownNameError(f"no output {name!r}; outputs are {', '.join(self.output_names)}")
         return self.outputs[:, self.output_names.index(name)]
 
     def state(self, name: str) -> np.ndarray:
-        """One state (e.g. ``"p1.theta"`` or ``"p1.theta_dot"``) on the time grid."""
+        """The state ``name`` (e.g. ``"p1.theta"`` or ``"p1.theta_dot"``) on the time grid."""
         if name not in self.state_names:
             raise UnknownNameError(f"no state {name!r}; states are {', '.join(self.state_names)}")
         return self.states[:, self.state_names.index(name)]
 
 
 def rk4_step(dm: DerivedModel, substeps: int = 1) -> ca.Function:
-    """``step(x, U, p, t, h) -> x_next``: ``substeps`` RK4 steps over ``[t, t + h]``.
+    """``step(x, U, p, t, h) -> x_next`` of the derived model ``dm``: ``substeps`` RK4
+    steps over ``[t, t + h]``.
 
     ``U`` (a column of ``nu * (2 substeps + 1)`` values) stacks the input vectors at the
     ``2 * substeps + 1`` equally spaced stage times of the interval, first time first.

@@ -27,7 +27,7 @@ sys.path.insert(0, str(ROOT))
 from derive import RK4, Sine, simulate
 from derive.fmu import co_simulate, export_fmu
 from estimate.cli.export import export_model
-from estimate.fitting.params_io import read_params
+from estimate.fitting.record import read_params
 
 INPUTS = ("rig.x", "rig.x_dot", "rig.x_ddot")
 STEPS = (0.001, 0.005, 0.01)

@@ -39,7 +39,7 @@ from analogs.errors import InputError
 from .inputs import file_kind
 from .interrupts import deferred, temporary
 
-__all__ = ["NON_FINITE_KEY", "OutputError", "Outputs", "committed", "json_text"]
+__all__ = ["NON_FINITE_KEY", "OutputError", "Outputs", "committed", "json_text", "output_mode"]
 
 #: Key of the note that lists the values written as ``null`` because they were not finite.
 NON_FINITE_KEY = "non_finite"
@@ -64,9 +64,33 @@ class _Item:
 
 
 def _umask() -> int:
+    """The process's umask, read without changing it where the system says it (Linux
+    ``/proc/self/status``: no window in which another thread creates files under umask 0)."""
+    try:
+        with open("/proc/self/status") as fh:
+            for line in fh:
+                if line.startswith("Umask:"):
+                    return int(line.split()[1], 8)
+    except (OSError, ValueError, IndexError):
+        pass
     mask = os.umask(0)
     os.umask(mask)
     return mask
+
+
+def output_mode(*, folder: bool = False) -> int:
+    """The permission bits of a new output file (``0o666``) or folder (``0o777``) under the
+    process's umask, as ``open`` and ``mkdir`` would give them: a temporary file made by
+    :mod:`tempfile` is private (0600, 0700) and gets these before it is renamed into place.
+
+    Examples
+    --------
+    >>> import os
+    >>> old = os.umask(0o022); oct(output_mode()), oct(output_mode(folder=True))
+    ('0o644', '0o755')
+    >>> _ = os.umask(old)
+    """
+    return (0o777 if folder else 0o666) & ~_umask()
 
 
 def _remove(path: Path) -> None:
@@ -217,13 +241,12 @@ class Outputs:
 
     def _commit(self, temps: Mapping[str, Path]) -> None:
         moves = self._moves(temps)
-        mask = _umask()
         backups: list[tuple[Path, Path]] = []
         done: list[Path] = []
         with deferred():  # all renames happen, or none
             try:
                 for tmp, final in moves:
-                    mode = (0o777 if tmp.is_dir() else 0o666) & ~mask
+                    mode = output_mode(folder=tmp.is_dir())
                     if final.exists() or final.is_symlink():
                         mode = final.stat().st_mode & 0o7777 if final.exists() else mode
                         backup = _placeholder(final, tmp.is_dir())

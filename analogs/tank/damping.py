@@ -83,7 +83,16 @@ def sphere_damping(radius: float, depth: float, viscosity: float, gravity: float
 def cylinder_damping(radius: float, depth: float, viscosity: float, gravity: float) -> float:
     """Damping ratio (fraction of critical) of slosh in an upright flat-bottomed cylinder.
 
-    Parameters as :func:`sphere_damping`.
+    Parameters
+    ----------
+    radius : float
+        Cylinder radius R in m.
+    depth : float
+        Liquid depth h in m.
+    viscosity : float
+        Kinematic viscosity in m^2/s.
+    gravity : float
+        Axial acceleration in m/s^2.
 
     Examples
     --------
@@ -99,7 +108,16 @@ def damping_validity(shape: str, radius: float, depth: float, viscosity: float,
     """Why the damping correlation of ``shape`` (``"sphere"`` or ``"cylinder"``) does not
     hold at this depth and liquid, or None when it does (see the module docstring).
 
-    Parameters as :func:`sphere_damping` (m, m, m^2/s, m/s^2).
+    Parameters
+    ----------
+    shape : str
+        ``"sphere"`` or ``"cylinder"``.
+    radius, depth : float
+        Tank radius and liquid depth in m.
+    viscosity : float
+        Kinematic viscosity in m^2/s.
+    gravity : float
+        Axial acceleration in m/s^2.
 
     Examples
     --------

@@ -59,6 +59,7 @@ class Liquid:
         _check_positive("viscosity", self.viscosity, "m^2/s")
 
 
+#: Water at 20 C, the default liquid of :func:`~analogs.tank.predict` and ``slosh tank``.
 WATER = Liquid()
 
 
@@ -158,13 +159,13 @@ class Tank:
                 return float(sl.point(np.array(sl.param_at(z)))[0])
         raise ValueError(f"`z` must lie in [0, {self.height}] m; got {z!r}.")
 
-    def section_rule(self, depth: float, nt: int, ns: int, *, grade: bool = False
+    def section_rule(self, depth: float, nt: int, ns: int
                      ) -> tuple[np.ndarray, np.ndarray, np.ndarray]:
         """Gauss rule over the liquid's meridian section ``0 <= r <= r_w(z), z <= depth``.
 
         Returns points ``r, z`` (m) and weights ``w`` (m^2) such that
-        ``sum(w * f(r, z))`` approximates the area integral of ``f``. ``nt`` points across,
-        ``ns`` points along each wall piece.
+        ``sum(w * f(r, z))`` approximates the area integral of ``f`` up to ``depth`` (m).
+        ``nt`` points across, ``ns`` points along each wall piece.
         """
         xt, wt = np.polynomial.legendre.leggauss(nt)
         xs, ws = np.polynomial.legendre.leggauss(ns)
@@ -227,8 +228,9 @@ class Tank:
         return float(np.sum(w * r * z) / np.sum(w * r))
 
     def rigid_inertia(self, depth: float, about: float) -> float:
-        """Pitch moment of inertia per unit density (m^5) of the liquid frozen solid,
-        about a horizontal axis through the tank axis at height ``about`` (m)."""
+        """Pitch moment of inertia per unit density (m^5) of the liquid frozen solid up to
+        ``depth`` (m), about a horizontal axis through the tank axis at height ``about``
+        (m)."""
         r, z, w = self.section_rule(depth, 6, 24)
         # integral of (x^2 + (z - a)^2) dV with x = r cos(theta): pi r^3 + 2 pi r (z-a)^2
         return float(np.sum(w * (math.pi * r**3 + 2.0 * math.pi * r * (z - about) ** 2)))

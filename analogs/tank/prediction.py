@@ -49,11 +49,16 @@ class Ritz:
     """Ritz with m = 1 solid harmonics up to ``degree`` (exponential convergence up to half
     full spheres, algebraic above: use ``degree >= 80`` beyond 85 % fill)."""
 
+    #: Highest degree of the solid harmonics.
     degree: int = 60
+    #: Relative cut-off of small singular values of the Ritz matrices (their conditioning
+    #: grows with the degree).
     rcond: float = 1e-12
+    #: The solver's name (``predict(method=...)``, reports).
     name: str = "ritz"
 
     def solve(self, tank: Tank, depth: float, n_modes: int) -> RawModes:
+        """The first ``n_modes`` lateral modes of ``tank`` filled to ``depth`` (m)."""
         return _ritz.solve(tank, depth, degree=self.degree, n_modes=n_modes, rcond=self.rcond)
 
 
@@ -65,9 +70,11 @@ class FiniteElements:
     degree: int = 7
     layers: int = 7
     ratio: float = 0.2
+    #: The solver's name (``predict(method=...)``, reports).
     name: str = "fem"
 
     def solve(self, tank: Tank, depth: float, n_modes: int) -> RawModes:
+        """The first ``n_modes`` lateral modes of ``tank`` filled to ``depth`` (m)."""
         return _fem.solve(tank, depth, degree=self.degree, layers=self.layers,
                           ratio=self.ratio, n_modes=n_modes)
 
@@ -79,9 +86,11 @@ class Legacy:
 
     n_poly: int = 5
     n_bessel: int = 5
+    #: The solver's name (``predict(method=...)``, reports).
     name: str = "legacy"
 
     def solve(self, tank: Tank, depth: float, n_modes: int) -> RawModes:
+        """The first ``n_modes`` lateral modes of ``tank`` filled to ``depth`` (m)."""
         return _legacy.solve(tank, depth, n_poly=self.n_poly, n_bessel=self.n_bessel,
                              n_modes=n_modes)
 
@@ -91,9 +100,11 @@ class Exact:
     """Converged answer: Ritz where it converges fast (spheres up to 75 % depth, shallow
     cylinders), graded finite elements elsewhere."""
 
+    #: The solver's name (``predict(method=...)``, reports).
     name: str = "exact"
 
     def choose(self, tank: Tank, depth: float) -> Ritz | FiniteElements:
+        """The solver that converges fast for ``tank`` filled to ``depth`` (m)."""
         if isinstance(tank, Sphere) and depth <= 1.5 * tank.radius:
             return Ritz(degree=40 if depth <= tank.radius else 60)
         if isinstance(tank, Cylinder) and depth <= 2.0 * tank.radius:
@@ -101,6 +112,7 @@ class Exact:
         return FiniteElements()
 
     def solve(self, tank: Tank, depth: float, n_modes: int) -> RawModes:
+        """The first ``n_modes`` lateral modes of ``tank`` filled to ``depth`` (m)."""
         return self.choose(tank, depth).solve(tank, depth, n_modes)
 
 
@@ -109,12 +121,18 @@ Solver = Union[Exact, Ritz, FiniteElements, Legacy]
 METHODS = {"exact": Exact, "ritz": Ritz, "fem": FiniteElements, "legacy": Legacy}
 
 
+#: What the damping ratio of the higher modes is (the tank report's footnote and note).
+MODE1_DAMPING = ("the first mode's damping ratio: the SP-106 correlations are for the first "
+                 "mode, and the SLOSH code gives the same value to every mode; estimate a "
+                 "higher mode's damping from data")
+
+
 # -- results -------------------------------------------------------------------------------
 @dataclass(frozen=True)
 class SloshMode:
     """One lateral slosh mode as a pendulum. SI units; heights from the tank bottom."""
 
-    index: int
+    index: int  #: mode number, 1 for the first
     frequency_hz: float  #: natural frequency, Hz
     lam: float  #: eigenvalue omega^2 / g, 1/m
     mass: float  #: pendulum (slosh) mass, kg
@@ -141,7 +159,40 @@ class FixedMassPrediction:
 
 @dataclass(frozen=True)
 class TankPrediction:
-    """Predicted analog parameters for a tank, fill and liquid (see :func:`predict`)."""
+    """Predicted analog parameters for a tank, fill and liquid (see :func:`predict`).
+
+    Attributes
+    ----------
+    tank : Tank or Rectangular
+        The tank geometry.
+    liquid : Liquid
+        Density and kinematic viscosity.
+    gravity : float
+        Axial acceleration, m/s^2.
+    depth : float
+        Liquid depth, m.
+    fill_fraction, volume_fraction : float
+        Depth over the tank's height, liquid volume over the tank's volume.
+    liquid_mass : float
+        Mass of the liquid, kg.
+    liquid_cg_height : float
+        Height of the liquid's centre of mass above the tank bottom, m.
+    method, solver : str
+        The method asked for (``"exact"``, ``"legacy"``, ...) and the solver it used
+        (``"ritz"``, ``"fem"``, ``"closed form"``).
+    modes : tuple of SloshMode
+        The lateral slosh modes kept, as pendulums.
+    fixed_mass : FixedMassPrediction
+        The liquid that does not slosh: mass, height and pitch inertia.
+    diaphragm : bool
+        The tank has a diaphragm (the prediction is still the free-surface one).
+    size : int
+        Unknowns of the modal analysis (0 in closed form).
+    seconds : float
+        Time the modal analysis took, s.
+    notes : tuple of str
+        What the prediction says about itself (validity, the higher modes' damping, ...).
+    """
 
     tank: Tank
     liquid: Liquid
@@ -195,11 +246,19 @@ class TankPrediction:
             f"{'mode':>4} {'f [Hz]':>8} {'lambda R':>9} {'mass [kg]':>10} {'L [m]':>8} "
             f"{'hinge [m]':>10} {'wave/bob':>9} {'zeta [%]':>9}",
         ]
+        copied = False
         for m in self.modes:
+            mark = " *" if m.index > 1 and math.isfinite(m.damping_ratio) else ""
+            copied = copied or bool(mark)
             lines.append(f"{m.index:>4} {m.frequency_hz:8.4f} {m.lam * t.radius:9.5f} "
                          f"{m.mass:10.4f} {m.length:8.4f} {m.hinge_height:10.4f} "
-                         f"{m.amplitude_ratio:9.4f} {100 * m.damping_ratio:9.4f}")
+                         f"{m.amplitude_ratio:9.4f} {100 * m.damping_ratio:9.4f}{mark}")
         f = self.fixed_mass
+        lines += ["", "L: pendulum length; hinge: hinge height above the tank bottom; wave/bob: "
+                      "wave height at the wall over the bob's lateral amplitude; zeta: damping "
+                      "ratio (SP-106 wall boundary layer)"]
+        if copied:
+            lines.append("* the first mode's value (see the note below)")
         lines += ["", f"fixed mass {f.mass:.4f} kg at {f.height:.4f} m, pitch inertia "
                       f"{f.inertia:.5f} kg m^2 (frozen-liquid convention)"]
         lines += [f"note: {n}" for n in self.notes]
@@ -209,8 +268,8 @@ class TankPrediction:
         """A ready analog model: rig + fixed mass + one damped pendulum per kept mode.
 
         Predicted values are the defaults; the pendulum length is bounded to
-        ``(1 -+ bound_fraction)`` times its prediction. The hinge damper coefficient is
-        ``c = 2 zeta m L^2 omega`` (N m s/rad).
+        ``(1 -+ bound_fraction)`` times its prediction (``bound_fraction`` default 0.2).
+        The hinge damper coefficient is ``c = 2 zeta m L^2 omega`` (N m s/rad).
 
         Examples
         --------
@@ -352,6 +411,8 @@ def predict(tank: Tank | Rectangular, *, fill: float | None = None, volume_fill:
     if diaphragm:
         notes.append("diaphragm: this is the free-surface prediction; a diaphragm raises the "
                      "frequency, lowers the slosh mass and adds damping - estimate them from data")
+    if len(out) > 1 and math.isfinite(zeta):
+        notes.append(f"modes 2 and up: {MODE1_DAMPING}")
     if not math.isfinite(zeta):
         what = "general profile" if tank.shape == "profile" else f"{tank.shape} tank"
         notes.append(f"no damping correlation for a {what}: damping_ratio is nan")

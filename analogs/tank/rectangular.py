@@ -107,8 +107,9 @@ class Rectangular:
         return 0.5 * depth
 
     def rigid_inertia(self, depth: float, about: float) -> float:
-        """Moment of inertia per unit density (m^5) of the liquid frozen solid about the
-        horizontal axis across the motion (``y``) at height ``about`` (m)."""
+        """Moment of inertia per unit density (m^5) of the liquid frozen solid up to
+        ``depth`` (m) about the horizontal axis across the motion (``y``) at height
+        ``about`` (m)."""
         a, b = self.length, self.width
         return b * (a**3 * depth / 12.0 + a * ((depth - about) ** 3 + about**3) / 3.0)
 

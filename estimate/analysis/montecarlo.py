@@ -24,7 +24,7 @@ from analogs.errors import InputError
 from derive import DerivedModel, Excitation, NoExcitation, rk4_step
 
 from ..executor import Executor, LocalExecutor, chunks
-from ..fitting.params_io import Fit, read_fit
+from ..fitting.record import Fit, read_fit
 
 __all__ = ["Fit", "read_fit", "draw_parameters", "MonteCarlo", "MonteCarloResult",
            "monte_carlo", "derived_quantities", "PERCENTILES"]
@@ -163,7 +163,11 @@ class MonteCarloResult:
     values; ``envelopes[name][q]`` the ``q``-th percentile over draws at each time;
     ``derived[name]`` per draw (``peak_<output>`` is the largest magnitude over the run,
     ``pN.frequency_hz`` and ``pN.damping_ratio`` from
-    the drawn parameters).
+    the drawn parameters). ``time`` is the grid (s); ``draws`` the drawn values
+    ``(samples, len(parameter_names))`` (``parameter_names`` the drawn parameters);
+    ``seed`` the random seed; ``acceptance`` the share
+    of normal draws inside the parameters' bounds; ``seconds`` the run time and
+    ``executor`` where it ran; ``percentiles`` those of the envelopes.
     """
 
     time: np.ndarray
@@ -279,8 +283,24 @@ class MonteCarloResult:
 
 @dataclass(frozen=True)
 class MonteCarlo:
-    """A Monte Carlo problem: a derived model, its time grid and excitation, the fixed
-    parameter values, and the fit whose covariance the draws come from."""
+    """A Monte Carlo problem.
+
+    Attributes
+    ----------
+    derived : DerivedModel
+        The model simulated for every draw.
+    time : ndarray
+        The output grid (s).
+    excitation : Excitation or None
+        The rig's input signals (None: a rig that needs none).
+    fit : Fit
+        The fit record whose estimates and covariance the draws come from
+        (:func:`~estimate.fitting.record.read_fit`).
+    fixed : mapping
+        Parameter values that are not drawn (the case's rig values), over the fit's.
+    outputs : tuple of str, optional
+        The outputs kept (default: the channels the rig measures).
+    """
 
     derived: DerivedModel
     time: np.ndarray
@@ -390,7 +410,8 @@ def monte_carlo(derived: DerivedModel, time: np.ndarray, excitation: Excitation 
                 outputs: Sequence[str] | None = None, seed: int | None = 0,
                 executor: Executor | None = None, batch_size: int = 256,
                 compile: bool = True, progress: bool | None = None) -> MonteCarloResult:
-    """Run :class:`MonteCarlo` in one call; see :meth:`MonteCarlo.run`.
+    """Run :class:`MonteCarlo` (``derived``, ``time``, ``excitation``, ``fit``, ``fixed``,
+    ``outputs``: its attributes) in one call; see :meth:`MonteCarlo.run`.
 
     Examples
     --------

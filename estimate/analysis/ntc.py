@@ -112,8 +112,10 @@ def _functions(dm: DerivedModel, p: np.ndarray):
 
 def steady_spin(model: DerivedModel | Model, params: Mapping[str, float] | None = None
                 ) -> dict[str, float]:
-    """Coordinates of steady spin at the nominal rate (all rates zero, all accelerations
-    zero), found by SciPy least squares from the all-zero state.
+    """Coordinates of steady spin of ``model`` (a :class:`~analogs.spacecraft.FreeSpacecraft`
+    model, derived or not) with the parameter values ``params`` (over its defaults) at the
+    nominal rate (all rates zero, all accelerations zero), found by SciPy least squares
+    from the all-zero state.
 
     Off-axis masses shift the centre of mass (``bus.x``...) and tilt the spin axis; cyclic
     coordinates (rotor angles, ``bus.psi``) stay at zero.
@@ -152,7 +154,9 @@ def steady_spin(model: DerivedModel | Model, params: Mapping[str, float] | None 
 
 def linearize(model: DerivedModel | Model, params: Mapping[str, float] | None = None,
               equilibrium: Mapping[str, float] | None = None) -> tuple[np.ndarray, np.ndarray]:
-    """State matrix ``A = d xdot / d x`` (CasADi AD) at steady spin, and the state there.
+    """State matrix ``A = d xdot / d x`` (CasADi AD) of ``model`` with the values
+    ``params`` at steady spin (``equilibrium``: its coordinates, default
+    :func:`steady_spin`), and the state there.
 
     States are ``[q; qd]`` in the derived model's order.
     """
@@ -177,7 +181,8 @@ def _transverse_rate_gradient(dm: DerivedModel, rig: FreeSpacecraft, spin: float
 
 
 def envelope_growth_rate(t: np.ndarray, signal: np.ndarray) -> tuple[float, np.ndarray, np.ndarray]:
-    """Exponential rate ``sigma`` (1/s) of the envelope of an oscillating ``signal``.
+    """Exponential rate ``sigma`` (1/s) of the envelope of an oscillating ``signal`` sampled
+    at the times ``t`` (s).
 
     The local maxima (refined by a parabola through the three samples around each) of a
     mode ``A exp(sigma t) cos(w t + c)`` form a geometric sequence; ``sigma`` is the slope

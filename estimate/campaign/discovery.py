@@ -51,10 +51,10 @@ _GROUP_KEYS = {"records", "model"}
 
 @dataclass(frozen=True)
 class Setup:
-    """What makes records one group: rig kind, ``[tank]`` (shape, radius in m - NaN for a
-    rectangular tank -, fill fraction, diaphragm, the shape's other sizes in m) and
-    ``[liquid]`` (density in kg/m^3, kinematic viscosity in m^2/s), and ``[rig] gravity``
-    (m/s^2) for the tank prediction."""
+    """What makes records one group: ``rig`` kind, ``[tank]`` (``shape``, ``radius`` in m -
+    NaN for a rectangular tank -, ``fill_fraction``, ``diaphragm``, the shape's other
+    ``sizes`` in m) and ``[liquid]`` (``density`` in kg/m^3, kinematic ``viscosity`` in
+    m^2/s), and ``[rig] gravity`` (``gravity``, m/s^2) for the tank prediction."""
 
     rig: str
     shape: str
@@ -124,7 +124,8 @@ class Record:
 
 @dataclass(frozen=True)
 class Group:
-    """Records fitted together (shared physical parameters) with ``model``."""
+    """Records fitted together (shared physical parameters) with ``model``: the group's
+    ``name`` and its ``records`` (ids)."""
 
     name: str
     records: tuple[str, ...]
@@ -133,7 +134,23 @@ class Group:
 
 @dataclass(frozen=True)
 class Campaign:
-    """A discovered campaign (see :func:`discover`)."""
+    """A discovered campaign (see :func:`discover`).
+
+    Attributes
+    ----------
+    source : str
+        The folder or glob given.
+    root : Path
+        The campaign folder (of ``campaign.toml``, and of the records' relative paths).
+    title, note : str
+        ``[campaign] title`` and ``note`` (empty when not given).
+    model, input : str
+        The campaign's model specification and carriage input mode.
+    records : tuple of Record
+        Every case file found, by path.
+    groups : tuple of Group
+        The groups fitted together.
+    """
 
     source: str
     root: Path
@@ -147,13 +164,15 @@ class Campaign:
     skipped: tuple[str, ...] = ()
 
     def record(self, record_id: str) -> Record:
+        """The record whose ``[test] id`` is ``record_id``."""
         return next(r for r in self.records if r.id == record_id)
 
     def group_of(self, record_id: str) -> Group | None:
+        """The group of the record ``record_id``, or None (in no group)."""
         return next((g for g in self.groups if record_id in g.records), None)
 
     def model_of(self, record_id: str) -> str:
-        """The model of a record: its group's."""
+        """The model of the record ``record_id``: its group's, else the campaign's."""
         group = self.group_of(record_id)
         return group.model if group is not None else self.model
 

@@ -31,7 +31,8 @@ MIN_RECORDS = 3
 
 @dataclass(frozen=True)
 class Outlier:
-    """A record flagged against its group, with one reason per quantity beyond ``z*``."""
+    """The ``record`` flagged against its ``group``, with one of its ``reasons`` per quantity
+    beyond ``z*``."""
 
     record: str
     group: str

@@ -19,6 +19,7 @@ from typing import Any
 
 from ..diagnosis.scoring import NOISE_MARGIN
 from ..inputs import load_json
+from ..outputs import output_mode
 from .discovery import Setup
 from .outliers import FAMILY_ERROR, MIN_RECORDS
 from .plots import amplitude_varies, plot_against_amplitude, plot_against_fill, plotted_quantities
@@ -81,6 +82,17 @@ def _group_section(row: dict[str, Any], table: CampaignTable, setup: Setup | Non
     return lines + [""]
 
 
+def _verdict(run: CampaignRun, row: dict[str, Any]) -> str:
+    """A record's diagnosis verdict with the estimates of what it found
+    (``slosh_mode (+p2): p2.mass 0.0661 +/- 0.0021 kg, ...``)."""
+    from .tasks import found_quantities
+
+    found = found_quantities(run.diagnoses.get(row["id"], {}))
+    parts = [f"`{k}` {_num(v[0])} +/- {_num(v[1])}{' ' + v[4] if v[4] not in ('', '-') else ''}"
+             for k, v in found.items()]
+    return row["verdict"] + (": " + ", ".join(parts) if parts else "")
+
+
 def summary(run: CampaignRun, table: CampaignTable, *, figures: list[str]) -> str:
     """The Markdown report of a campaign run."""
     c = run.campaign
@@ -124,7 +136,7 @@ def summary(run: CampaignRun, table: CampaignTable, *, figures: list[str]) -> st
                   f"RMS residual more than {MISFIT_RATIO:g} times the force noise:", ""]
         lines += [f"- **{r['id']}**: {r['residual/noise']:.2f} x the noise "
                   f"({_num(r['rms_residual [N]'])} N against {_num(r['noise [N]'])} N)"
-                  + (f"; diagnosis: {r['verdict']}" if r["verdict"] else "") for r in misfit]
+                  + (f"; diagnosis: {_verdict(run, r)}" if r["verdict"] else "") for r in misfit]
         lines.append("")
     if failed:
         lines += ["## Failed", ""] + [f"- {r['kind']} **{r['id']}**: {r['error']}" for r in failed]
@@ -137,7 +149,7 @@ def summary(run: CampaignRun, table: CampaignTable, *, figures: list[str]) -> st
         amp = r["drive_amplitude [m]"]
         lines.append(f"| {r['id']}{' (outlier)' if r['outlier'] else ''} | {r['group']} | "
                      f"{_num(1e3 * amp) if amp is not None else ''} | " + " | ".join(cells)
-                     + f" | {_num(r['residual/noise'])} | {r['status']} | {r['verdict']} |")
+                     + f" | {_num(r['residual/noise'])} | {r['status']} | {_verdict(run, r)} |")
     lines += ["", "Full table with standard errors and intervals: `campaign.csv`, "
               "`campaign.parquet`.", ""]
     if c.skipped:
@@ -182,6 +194,7 @@ def write_outputs(run: CampaignRun, out: str | Path) -> CampaignTable:
     csv_bytes, parquet_bytes = table.to_csv(), table.to_parquet()
     tmp = Path(tempfile.mkdtemp(dir=out, prefix=".report."))
     try:
+        os.chmod(tmp, output_mode(folder=True))  # readable as any other output, not 0700
         _report_folder(run, table, tmp)
         write_atomic(out / "campaign.csv", csv_bytes)
         write_atomic(out / "campaign.parquet", parquet_bytes)

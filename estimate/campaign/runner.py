@@ -45,6 +45,8 @@ class CampaignRun:
 
     Attributes
     ----------
+    campaign : Campaign
+        What was run (:func:`~estimate.campaign.discover`).
     records, diagnoses : dict
         Fit and diagnosis outcome by record id (diagnoses empty unless asked for).
     groups : dict

@@ -29,6 +29,7 @@ from typing import Any
 from analogs.errors import InputError
 
 from ..inputs import load_json
+from ..version import package_version
 
 __all__ = ["MAX_ENTRY_BYTES", "STORE_SCHEMA", "Store", "outcome_checksum", "package_version",
            "task_key", "write_atomic"]
@@ -43,16 +44,6 @@ def outcome_checksum(outcome: Mapping[str, Any]) -> str:
     """SHA-256 of an outcome's canonical JSON (sorted keys; NaN written as ``NaN``)."""
     text = json.dumps(outcome, sort_keys=True, separators=(",", ":"), allow_nan=True)
     return hashlib.sha256(text.encode()).hexdigest()
-
-
-def package_version() -> str:
-    """The installed version of slosh-analogs ("unknown" when not installed)."""
-    from importlib.metadata import PackageNotFoundError, version
-
-    try:
-        return version("slosh-analogs")
-    except PackageNotFoundError:  # pragma: no cover - running from an uninstalled checkout
-        return "unknown"
 
 
 def task_key(task: str, files: Sequence[tuple[str | None, str | None]], model: str | None,
@@ -78,7 +69,11 @@ def task_key(task: str, files: Sequence[tuple[str | None, str | None]], model: s
 
 def write_atomic(path: str | os.PathLike[str], data: bytes) -> Path:
     """Write ``data`` to ``path`` through a hidden temporary file in the same folder and a
-    rename: readers see the old file or the new one, never a part."""
+    rename: readers see the old file or the new one, never a part. The file gets the mode
+    of any other output (:func:`estimate.outputs.output_mode`: 0644 under umask 022), not
+    the temporary file's 0600."""
+    from ..outputs import output_mode
+
     path = Path(path)
     fd, tmp = tempfile.mkstemp(dir=path.parent, prefix=f".{path.name}.", suffix=".tmp")
     try:
@@ -86,6 +81,7 @@ def write_atomic(path: str | os.PathLike[str], data: bytes) -> Path:
             fh.write(data)
             fh.flush()
             os.fsync(fh.fileno())
+        os.chmod(tmp, output_mode())
         os.replace(tmp, path)
     except BaseException:
         Path(tmp).unlink(missing_ok=True)
@@ -155,7 +151,7 @@ class Store:
         return write_atomic(self._path(key), json.dumps(entry, indent=1, allow_nan=True).encode())
 
     def seconds(self, key: str) -> float | None:
-        """How long the stored task took (s), or None."""
+        """How long the task stored under ``key`` took (s), or None."""
         try:
             return float(self._entry(key)["seconds"])
         except (OSError, ValueError, KeyError, TypeError, InputError):

@@ -5,9 +5,10 @@ the row is (kind, id, group, fitted records, status, error), the tank, fill and 
 the drive amplitude, the model, then for every shared parameter and derived quantity its
 estimate, standard error and 95 % interval (units in the column names), then the RMS
 residual against the force noise, the diagnosis verdict and the outlier flag with its
-reasons. Rows and columns depend only on the stored results, never on timings or on the
-order tasks ended in, so an interrupted and resumed run writes the same bytes as an
-uninterrupted one.
+reasons, and with ``--diagnose`` the estimate and standard error of every quantity of each
+record's diagnosed model (``diagnosed p2.mass [kg]``: what the diagnosis found). Rows and
+columns depend only on the stored results, never on timings or on the order tasks ended
+in, so an interrupted and resumed run writes the same bytes as an uninterrupted one.
 """
 
 from __future__ import annotations
@@ -32,6 +33,10 @@ _META = [("kind", str), ("id", str), ("group", str), ("records", str), ("status"
 _TAIL = [("rms_residual [N]", float), ("noise [N]", float), ("residual/noise", float),
          ("verdict", str), ("outlier", bool), ("outlier_reasons", str), ("excluded", str)]
 _STATS = (("", 0), (" stderr", 1), (" lo95", 2), (" hi95", 3))
+#: Prefix of the columns of a record's diagnosed (final) model, with ``--diagnose``: its
+#: estimates and standard errors, the found components' among them (``diagnosed p2.mass
+#: [kg]``).
+DIAGNOSED = "diagnosed"
 
 
 def _unit(unit: str) -> str:
@@ -45,7 +50,8 @@ def quantity_column(name: str, unit: str, stat: str = "") -> str:
 
 @dataclass(frozen=True)
 class CampaignTable:
-    """Columns (name, type) and rows (dicts by column name; missing values are None)."""
+    """``columns`` (name, type) and ``rows`` (dicts by column name; missing values are
+    None)."""
 
     columns: tuple[tuple[str, type], ...]
     rows: tuple[dict[str, Any], ...]
@@ -137,10 +143,11 @@ def _group_verdict(run: CampaignRun, members: tuple[str, ...]) -> str:
 
 
 def campaign_table(run: CampaignRun) -> CampaignTable:
-    """The table of a campaign run (see the module docstring for its layout)."""
+    """The table of the campaign ``run`` (see the module docstring for its layout)."""
     c = run.campaign
     flagged = {o.record: o for o in run.outliers}
     units: dict[str, str] = {}
+    final_units: dict[str, str] = {}  # the diagnoses' final models (--diagnose)
     rows = []
 
     def record_row(rid: str, group: str) -> dict[str, Any]:
@@ -153,6 +160,11 @@ def campaign_table(run: CampaignRun) -> CampaignTable:
         if rid in run.diagnoses:
             d = run.diagnoses[rid]
             row["verdict"] = d.get("verdict") or f"failed: {d.get('error')}"
+            for table in ("final_parameters", "final_derived"):
+                for name, values in (d.get(table) or {}).items():
+                    final_units.setdefault(name, values[4])
+                    for stat, i in _STATS[:2]:
+                        row[quantity_column(f"{DIAGNOSED} {name}", values[4], stat)] = values[i]
         return row
 
     for g in c.groups:
@@ -169,7 +181,9 @@ def campaign_table(run: CampaignRun) -> CampaignTable:
     rows += [record_row(r.id, "") for r in c.records if r.id not in grouped]
     quantity_cols = [(quantity_column(n, u, stat), float) for n, u in units.items()
                      for stat, _ in _STATS]
-    columns = tuple(_META + quantity_cols + _TAIL)
+    final_cols = [(quantity_column(f"{DIAGNOSED} {n}", u, stat), float)
+                  for n, u in final_units.items() for stat, _ in _STATS[:2]]
+    columns = tuple(_META + quantity_cols + _TAIL + final_cols)
     clean = tuple({k: _typed(row.get(k), t) for k, t in columns} for row in rows)
     return CampaignTable(columns, clean, dict(units))
 

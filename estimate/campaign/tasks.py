@@ -17,7 +17,8 @@ from analogs.errors import InputError
 
 from ..data.case import Case
 
-__all__ = ["FAILURE_CAUSES", "Task", "check_outcome", "drive_amplitude", "run_task"]
+__all__ = ["FAILURE_CAUSES", "Task", "check_outcome", "drive_amplitude", "found_quantities",
+           "run_task"]
 
 #: Why a task failed, as its outcome's ``failure`` says: ``"inputs"`` (the case files, data
 #: or model: stored, and not retried until they change) or ``"environment"`` (the machine,
@@ -135,9 +136,11 @@ def _diagnosis(task: Task) -> dict[str, Any]:
                  "bic_change": f.bic_change} for f in d.findings]
     verdict = ("; ".join(f"{f['cause']} (+{', '.join(f['added'])})" for f in findings)
                or "no finding")
+    params, derived = _quantities(d.final)
     return {"status": "ok", "error": None, "cases": [c.test.id for c in task.cases],
             "verdict": verdict, "findings": findings,
             "final_model": list(d.final.problem.model.names),
+            "final_parameters": params, "final_derived": derived,
             "rms_baseline": float(d.baseline.rms_residual),
             "rms_final": float(d.final.rms_residual), "notes": list(d.notes)}
 
@@ -210,4 +213,18 @@ def check_outcome(kind: str, outcome: dict[str, Any]) -> str | None:
         if not isinstance(outcome.get("verdict"), str) or not isinstance(
                 outcome.get("findings"), list):
             return "expected a diagnosis with `verdict` and `findings`"
+        for key in ("final_parameters", "final_derived"):  # absent in entries of before
+            if key in outcome and not _quantity_rows(outcome[key]):
+                return f"`{key}`: expected quantities as [value, stderr, lo, hi, unit]"
     return None
+
+
+def found_quantities(diagnosis: dict[str, Any]) -> dict[str, list]:
+    """The final model's estimates and derived quantities of what a diagnosis outcome
+    added (``p2.mass``, ``p2.frequency_hz`` for a finding ``+p2``), as ``[value, stderr,
+    lo, hi, unit]``; empty without findings (or for an outcome stored before the final
+    estimates were kept)."""
+    added = [a for f in diagnosis.get("findings") or () for a in f.get("added") or ()]
+    table = {**(diagnosis.get("final_parameters") or {}), **(diagnosis.get("final_derived") or {})}
+    return {k: v for k, v in table.items()
+            if any(k == a or k.startswith(f"{a}.") for a in added)}

@@ -1,5 +1,5 @@
 """The ``slosh`` command line, one module per command: ``fit``, ``simulate``, ``diagnose``,
-``tank``, ``export``, ``montecarlo``, ``ntc``, ``campaign``, ``design``."""
+``tank``, ``export``, ``montecarlo``, ``ntc``, ``campaign``, ``design``, ``compare``."""
 
 from __future__ import annotations
 
@@ -12,14 +12,18 @@ from contextlib import contextmanager
 __all__ = ["main"]
 
 _COMMANDS = ("fit", "simulate", "diagnose", "tank", "export", "montecarlo", "ntc", "campaign",
-             "design")
+             "design", "compare")
 
 
 def _parser() -> argparse.ArgumentParser:
     import importlib
 
+    from ..version import package_version
+
     parser = argparse.ArgumentParser(
         prog="slosh", description="Fuel-slosh tank tests to mechanical analog models.")
+    parser.add_argument("--version", action="version",
+                        version=f"slosh-analogs {package_version()}")
     sub = parser.add_subparsers(dest="command", required=True)
     for name in _COMMANDS:
         importlib.import_module(f"{__name__}.{name}").add_parser(sub)

@@ -9,7 +9,7 @@ from typing import TYPE_CHECKING
 if TYPE_CHECKING:  # the parser of every command imports this module: load nothing yet
     from ..data import Case
 
-__all__ = ["add_force", "add_strict", "load_cases", "positive_hz"]
+__all__ = ["add_force", "add_strict", "assignments", "load_cases", "positive_hz"]
 
 
 def add_strict(parser) -> None:
@@ -21,29 +21,34 @@ def add_strict(parser) -> None:
 
 def add_force(parser) -> None:
     """The ``--force`` option of a command that takes a fit result
-    (:func:`estimate.fitting.params_io.fit_notes`)."""
+    (:func:`estimate.fitting.record.fit_notes`)."""
     parser.add_argument("--force", action="store_true",
                         help="use a fit result that did not converge (`converged: false`), with "
                              "a warning; refused without it")
 
 
 def load_cases(paths: Sequence[str], *, prediction: bool = False, strict: bool = False,
-               motion_band_hz: float | None = None) -> tuple[list["Case"], list[str]]:
+               motion_band_hz: float | None = None, shared: bool = False
+               ) -> tuple[list["Case"], list[str]]:
     """The cases of ``paths`` and warnings about them (``strict``: unknown keys are errors,
     :func:`estimate.data.load_case`).
 
     A record given twice is refused (:func:`estimate.data.records.refuse_repeated`);
     ``prediction``: a ``[prediction]`` that contradicts the tank's own modal prediction is
     a warning (:func:`estimate.fitting.initial.prediction_conflicts`); ``motion_band_hz``
-    (``--motion-band``, Hz) replaces every case's ``[test] motion_band_hz``.
+    (``--motion-band``, Hz) replaces every case's ``[test] motion_band_hz``; ``shared``:
+    the cases are fitted with shared parameters, so records of different tanks, fills or
+    liquids are refused (:func:`estimate.data.records.refuse_mixed`).
     """
     from ..data import load_case
-    from ..data.records import refuse_repeated
+    from ..data.records import refuse_mixed, refuse_repeated
 
     cases = [load_case(p, strict=strict) for p in paths]
     if motion_band_hz is not None:
         cases = [replace(c, test=replace(c.test, motion_band_hz=motion_band_hz)) for c in cases]
     refuse_repeated(cases)
+    if shared:
+        refuse_mixed(cases)
     notes: list[str] = []
     if prediction:
         from ..fitting.initial import prediction_conflicts
@@ -65,3 +70,27 @@ def positive_hz(text: str) -> float:
     if not (math.isfinite(value) and value > 0):
         raise argparse.ArgumentTypeError(f"expected a positive frequency in Hz, found {text!r}")
     return value
+
+
+def assignments(items: Sequence[str]) -> dict[str, float]:
+    """Values of ``--set NAME=VALUE`` options by name.
+
+    Raises
+    ------
+    InputError
+        Naming every item that is not ``NAME=NUMBER``.
+    """
+    from analogs.errors import InputError
+
+    out, problems = {}, []
+    for item in items:
+        name, sep, value = item.partition("=")
+        try:
+            if not sep:
+                raise ValueError
+            out[name.strip()] = float(value)
+        except ValueError:
+            problems.append(f"`--set {item}`: expected NAME=NUMBER")
+    if problems:
+        raise InputError("; ".join(problems))
+    return out

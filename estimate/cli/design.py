@@ -72,7 +72,7 @@ def run(args: argparse.Namespace) -> int:
 
     from ..data import load_case
     from ..design import GOAL, MAX_SWING, DesignProblem, design, discrimination
-    from ..fitting.params_io import fit_notes
+    from ..fitting.record import fit_notes
 
     drive_out = args.drive or str(Path(args.json_out).with_name(
         Path(args.json_out).stem + "_drive.csv"))

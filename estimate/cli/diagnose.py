@@ -42,7 +42,7 @@ def run(args: argparse.Namespace) -> int:
     outputs = Outputs(overwrite=args.overwrite, inputs=args.cases)
     outputs.file("--json", args.json_out).folder("--report", args.report, REPORT_FILES).check()
     cases, notes = load_cases(args.cases, prediction=True, strict=args.strict,
-                              motion_band_hz=args.motion_band)
+                              motion_band_hz=args.motion_band, shared=True)
     for w in notes:
         print(f"warning: {w}", file=sys.stderr)
     d = diagnose(cases)

@@ -18,7 +18,7 @@ from analogs.errors import InputError
 from analogs.vehicle import VehicleFrame, axisymmetric, degrees_of_freedom
 
 from ..outputs import Outputs
-from ._cases import add_force
+from ._cases import add_force, assignments
 
 __all__ = ["add_parser", "run", "export_model"]
 
@@ -48,8 +48,9 @@ def add_parser(subparsers: argparse._SubParsersAction) -> None:
                         "tank bottom to the free surface (default 0,0,1)")
     p.add_argument("--model", default=None,
                    help="model specification, e.g. 'fixed,p1' (default: the fit's model_spec)")
-    p.add_argument("--integrator", choices=("rk4", "adaptive"), default="rk4",
-                   help="rk4 (fixed step; the only one that can be generated as C)")
+    p.add_argument("--integrator", choices=("rk4",), default="rk4",
+                   help="rk4, fixed step (the only integrator that can be generated as C; "
+                        "CasADi's adaptive CVODES cannot); --substeps refines it")
     p.add_argument("--substeps", type=int, default=1, help="RK4 substeps per step (default 1)")
     p.add_argument("--interface", choices=("rig", "vehicle"), default="rig",
                    help="rig: lateral rig inputs rig.x, rig.x_dot, rig.x_ddot (default); "
@@ -121,55 +122,19 @@ def _print_dof(model: Model) -> None:
         print(f"    {line}")
 
 
-def _spec_of(path: Path) -> str | None:
-    """The model specification a fit file names, or None (a flat map of values)."""
-    from ..fitting.params_io import read_json
-
-    data = read_json(path, "fit file")
-    if not isinstance(data, dict):
-        return None
-    spec, model = data.get("model_spec"), data.get("model")
-    if spec is not None and not isinstance(spec, str):
-        raise InputError(f"{path}: `model_spec`: expected a string such as \"fixed,p1\", "
-                         f"found {spec!r}")
-    if spec:
-        return spec
-    if isinstance(model, list) and model and all(isinstance(m, str) for m in model):
-        return ",".join(model)
-    return None
-
-
-def _assignments(items: list[str]) -> dict[str, float]:
-    out, problems = {}, []
-    for item in items:
-        name, sep, value = item.partition("=")
-        try:
-            if not sep:
-                raise ValueError
-            out[name.strip()] = float(value)
-        except ValueError:
-            problems.append(f"`--set {item}`: expected NAME=NUMBER")
-    if problems:
-        raise InputError("; ".join(problems))
-    return out
-
-
 def run(args: argparse.Namespace) -> int:
     """Run ``slosh export``; returns the exit status."""
     from derive import derive
     from derive.export_c import c_export_files, export_c, has_c_compiler
 
     from ..data.models import BASELINE
-    from ..fitting.params_io import fit_notes, read_params
+    from ..fitting.record import fit_notes, fit_spec, read_params
 
     if not args.out and not args.fmu and not args.basilisk:
         raise InputError("nothing to write: give `--out DIR` for C sources, `--fmu OUT.fmu` "
                          "and/or `--basilisk OUT.py`")
     if (args.tank_position or args.tank_axis) and not args.basilisk:
         raise InputError("`--tank-position` and `--tank-axis` place the tank for `--basilisk`")
-    if args.integrator != "rk4":
-        raise InputError("only `--integrator rk4` can be exported: CasADi's cvodes integrator "
-                         "cannot be generated as C")
     if args.planar and args.interface != "vehicle":
         raise InputError("`--planar` applies to `--interface vehicle` only")
     if args.basilisk and not args.basilisk.endswith(".py"):
@@ -181,8 +146,8 @@ def run(args: argparse.Namespace) -> int:
                          "sources without one")
     for note in fit_notes(args.fit, force=args.force, what="parameter file"):
         print(f"warning: {note}", file=sys.stderr)
-    values = read_params(args.fit) | _assignments(args.set)
-    spec = args.model or _spec_of(Path(args.fit)) or BASELINE
+    values = read_params(args.fit) | assignments(args.set)
+    spec = args.model or fit_spec(args.fit) or BASELINE
     outputs = Outputs(overwrite=args.overwrite, inputs=[args.fit])
     outputs.folder("--out", args.out, [*c_export_files(args.name).values(), "simulate"])
     outputs.file("--fmu", args.fmu).file("--basilisk", args.basilisk).check()

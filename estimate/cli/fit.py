@@ -4,7 +4,7 @@ from __future__ import annotations
 
 import argparse
 
-from ..outputs import Outputs, json_text
+from ..outputs import Outputs
 from ._cases import add_strict, load_cases
 from ._cases import positive_hz as _positive_hz
 
@@ -18,23 +18,36 @@ def add_parser(sub: argparse._SubParsersAction) -> None:
                     "physical parameters, per-case crank corrections) with IPOPT.")
     p.add_argument("cases", nargs="+", help="test case files (TOML)")
     p.add_argument("--model", default=None,
-                   help="model specification, e.g. 'fixed,p1,p2' or 'fixed,p1:quadratic' "
-                        "(default: fixed,p1 = fixed mass + pendulum with hinge spring and damper)")
+                   help="model specification: comma-separated `fixed` (fixed mass) and `pN`, "
+                        "N from 1 to 6 (pendulum of slosh mode N with hinge spring and damper; "
+                        "spherical on the spinning rig), each pendulum with optional modifiers "
+                        "`:nospring`, `:quadratic` (adds a quadratic damper), `:diaphragm` "
+                        "(adds a diaphragm spring); spinning rig: `rotor` or `rN`; e.g. "
+                        "'fixed,p1:nospring,p2:quadratic' (default: fixed,p1)")
     p.add_argument("--transcription", choices=("multiple_shooting", "collocation"),
-                   default="multiple_shooting")
+                   default="multiple_shooting",
+                   help="how the equations of motion enter the NLP, whose variables include "
+                        "the states at every sample: multiple shooting (continuity after an "
+                        "RK4 step per sample interval, default) or direct collocation (Radau "
+                        "degree-3 polynomials per sample interval)")
     p.add_argument("--input", choices=("estimated", "filtered"), default=None,
                    help="a measured carriage displacement is estimated with the parameters "
                         "(default) or smoothed and differentiated beforehand (default with "
                         "--cost abs)")
     p.add_argument("--cost", choices=("squared", "abs"), default="squared",
-                   help="sum of squared residuals (default) or the seed's sum((|E|-|S|)^2)")
+                   help="sum of squared force residuals (default), or 'abs': "
+                        "sum((|measured| - |simulated|)^2), sample by sample, blind to the "
+                        "force's sign (the classical workflow's cost; filtered input)")
     p.add_argument("--channel-offsets", choices=("none", "offset", "drift"), default="none",
                    help="estimate a zero offset ('offset') or an offset and a linear drift "
                         "('drift') of every measured channel with the parameters, per case "
                         "(a transducer that is not zeroed or drifts); default: none")
     p.add_argument("--json", dest="json_out", default=None, help="write the result as JSON")
     p.add_argument("--plot", default=None, help="write the fit plots (PNG) of the first case")
-    p.add_argument("--report", action="store_true", help="print the full text fit report")
+    p.add_argument("--report", nargs="?", const="-", default=None, metavar="FILE.md",
+                   help="print the full text fit report; with a file name, write the report "
+                        "as Markdown there instead (with the provenance: versions, date, "
+                        "each data file's SHA-256, the options)")
     p.add_argument("--motion-band", type=_positive_hz, default=None, metavar="HZ",
                    help="highest frequency of the carriage motion (Hz): sets the estimated "
                         "carriage spline's knot spacing and the filtered input's displacement "
@@ -45,6 +58,26 @@ def add_parser(sub: argparse._SubParsersAction) -> None:
     p.set_defaults(run=run)
 
 
+#: Parsed options that are not options of the fit (the command's wiring).
+_NOT_OPTIONS = ("run", "command")
+
+
+def _report_file(args: argparse.Namespace) -> str | None:
+    """The Markdown report file of ``--report FILE.md`` (None: print, or no report)."""
+    from pathlib import Path
+
+    from analogs.errors import InputError
+
+    report = args.report
+    if report in (None, "-"):
+        return None
+    if Path(report).suffix.lower() == ".toml":  # `--report A1.toml`: the case, taken by --report
+        raise InputError(f"--report {report}: a case file where the report file was expected; "
+                         "give the report a .md name (`--report A1_fit.md`), or put `--report` "
+                         "after the case files")
+    return report
+
+
 def run(args: argparse.Namespace) -> int:
     import sys
 
@@ -52,12 +85,15 @@ def run(args: argparse.Namespace) -> int:
     from ..fitting.measurement import ChannelOffsets
     from ..fitting.nlp import fit
     from ..fitting.problem import FitProblem
+    from ..fitting.record import fit_json, fit_record, report_markdown
     from ..fitting.transcription import Collocation, MultipleShooting
 
+    report_file = _report_file(args)
     outputs = Outputs(overwrite=args.overwrite, inputs=args.cases)
-    outputs.file("--json", args.json_out).file("--plot", args.plot).check()
+    outputs.file("--json", args.json_out).file("--plot", args.plot)
+    outputs.file("--report", report_file).check()
     cases, notes = load_cases(args.cases, prediction=True, strict=args.strict,
-                              motion_band_hz=args.motion_band)
+                              motion_band_hz=args.motion_band, shared=True)
     for w in notes:  # before the fit, which starts from [prediction]
         print(f"warning: {w}", file=sys.stderr)
     spec = BASELINE if args.model is None else args.model
@@ -68,7 +104,8 @@ def run(args: argparse.Namespace) -> int:
     problem = FitProblem.build(cases, model, input=mode, measurement=measurement)
     tr = MultipleShooting() if args.transcription == "multiple_shooting" else Collocation()
     result = fit(problem, transcription=tr, cost=args.cost)
-    if args.report or sys.stdout.isatty():
+    printed = args.report == "-" or (args.report is None and sys.stdout.isatty())
+    if printed:
         print(result.report())
     else:
         print(f"{result.verdict}, "
@@ -86,14 +123,19 @@ def run(args: argparse.Namespace) -> int:
         for case in cases:  # what loading did to the record ([test] resample_hz)
             for n in case.notes:
                 print(f"  note: {n}")
-    for w in result.warnings:
-        print(f"warning: {w}", file=sys.stderr)
+    if not (printed and sys.stdout.isatty()):  # on a terminal the report holds them
+        for w in result.warnings:
+            print(f"warning: {w}", file=sys.stderr)
+    record = None
+    if args.json_out or report_file:
+        options = {k: v for k, v in vars(args).items() if k not in _NOT_OPTIONS}
+        record = fit_record(result, model_spec=args.model, options=options, command="slosh fit",
+                            warnings=notes)
     with outputs.writing() as paths:
         if args.json_out:
-            data = result.to_dict()
-            data["model_spec"] = spec
-            data["warnings"] = [*notes, *data.get("warnings", ())]
-            paths["--json"].write_text(json_text(data))
+            paths["--json"].write_text(fit_json(record))
+        if report_file:
+            paths["--report"].write_text(report_markdown(result, record))
         if args.plot:
             from ..fitting.plots import plot_fit
 

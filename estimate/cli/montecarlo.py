@@ -54,7 +54,7 @@ def run(args: argparse.Namespace) -> int:
     from ..data.experiment import experiment
     from ..data.models import model_from_spec
     from ..executor import executor_for
-    from ..fitting.params_io import fit_notes
+    from ..fitting.record import fit_notes
 
     if args.samples < 1:
         raise InputError(f"--samples must be at least 1, got {args.samples}")

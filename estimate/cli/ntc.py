@@ -33,6 +33,13 @@ File format (SI units; see ``examples/spacecraft.toml``)::
     [ntc]                   # optional
     duration = 2000.0       # s
     initial_rate = 5e-4     # rad/s
+
+``--fit FIT.json`` (a record of ``slosh fit``) gives the tank's analog instead of the file's
+``[[analog]]`` tables (:func:`analog_tables`): the fit's fixed mass becomes a ``fixed_mass``
+and each pendulum a ``spherical_pendulum`` (an axisymmetric tank sloshes alike in both
+lateral axes) with the fitted mass, length, hinge damping and spring, at the tank origin of
+``[tank]``; the heights and inertias a lateral record does not determine come from
+``--set NAME=VALUE``.
 """
 
 from __future__ import annotations
@@ -44,8 +51,9 @@ from pathlib import Path
 from analogs.errors import InputError
 
 from ..outputs import Outputs, json_text
+from ._cases import add_force, assignments
 
-__all__ = ["add_parser", "run", "load_spacecraft"]
+__all__ = ["add_parser", "analog_tables", "load_spacecraft", "run"]
 
 _BUS_KEYS = ("spin_rate", "mass", "inertia_x", "inertia_y", "inertia_z")
 _MOUNT_KEYS = {"mount_radius", "mount_azimuth", "mount_height", "mount_axis"}
@@ -64,9 +72,21 @@ def add_parser(subparsers: argparse._SubParsersAction) -> None:
         description="Nutation time constant (NTC = 1/sigma, positive when the nutation grows) "
                     "from a nonlinear simulation (envelope fit) and from the eigenvalues of "
                     "the equations linearised about steady spin.")
-    p.add_argument("spacecraft", help="spacecraft file (TOML)")
+    p.add_argument("spacecraft", help="spacecraft file (TOML): the bus, the tank's place and "
+                   "the analogs; every key is described in examples/spacecraft.toml and in "
+                   "`python3 -m pydoc estimate.cli.ntc`")
+    p.add_argument("--fit", metavar="FIT.json",
+                   help="the tank's analog from a fit record (`slosh fit --json`) instead of "
+                        "the file's [[analog]] tables: fixed mass and pendulums (spherical, "
+                        "as in an axisymmetric tank) with the fitted masses, lengths, damping "
+                        "and springs, at the tank origin")
+    p.add_argument("--set", metavar="NAME=VALUE", action="append", default=[],
+                   help="with --fit: a value the fit does not give (p1.hinge_height, "
+                        "fixed.height, fixed.inertia, fixed.axial_inertia: m, kg m^2) or one "
+                        "to replace; repeatable")
     p.add_argument("--json", metavar="OUT.json", help="write both NTCs as JSON")
     p.add_argument("--overwrite", action="store_true", help="replace an existing --json file")
+    add_force(p)
     p.set_defaults(run=run)
 
 
@@ -113,10 +133,14 @@ def _triangle(values: dict[str, float], keys: tuple[str, str, str], where: str,
                 return
 
 
-def load_spacecraft(path: str | Path):
+def load_spacecraft(path: str | Path, *, analogs: list[dict] | None = None,
+                    analogs_from: str | None = None):
     """Read a spacecraft file: returns ``(model, params, options)``.
 
-    Raises ``ValueError`` listing every problem (file, table, key) at once.
+    ``analogs`` replaces the file's ``[[analog]]`` tables (tables of the same keys, e.g.
+    :func:`analog_tables` of a fit), named ``analogs_from`` in messages.
+
+    Raises ``InputError`` listing every problem (file, table, key) at once.
     """
     from analogs import (
         FixedMass,
@@ -165,14 +189,15 @@ def load_spacecraft(path: str | Path):
         problems.append(f"{where}: `axis` must be \"spin\" or \"inward\", got {axis!r}")
         axis = "spin"
     components = []
-    analogs = doc.get("analog", [])
+    given = analogs is not None
+    analogs = analogs if given else doc.get("analog", [])
     if not isinstance(analogs, list) or not analogs:
         problems.append(f"{path}: no `[[analog]]` table; give at least one (rotor, pendulum, "
-                        "spherical_pendulum, fixed_mass)")
+                        "spherical_pendulum, fixed_mass), or a fit with --fit")
         analogs = []
     for i, a in enumerate(analogs, 1):
         kind, name = a.get("type"), a.get("name", f"a{i}")
-        where = f"{path} [[analog]] #{i}"
+        where = f"{analogs_from} `{name}`" if given else f"{path} [[analog]] #{i}"
         if kind not in _ANALOG_KEYS:
             problems.append(f"{where}: `type` must be one of {', '.join(_ANALOG_KEYS)}, got {kind!r}")
             continue
@@ -234,13 +259,107 @@ def load_spacecraft(path: str | Path):
     return model.validate(), params, options
 
 
+#: The spacecraft file's keys of each analog a fit's component gives (``--set`` names are
+#: dotted: ``p1.hinge_height``).
+_FROM_FIT = {"fixed_mass": ("mass", "height", "inertia", "axial_inertia"),
+             "spherical_pendulum": ("mass", "length", "hinge_height", "damping", "stiffness")}
+
+
+def analog_tables(spec: str, values: dict[str, float], *, source: str = "the fit"
+                  ) -> list[dict]:
+    """The ``[[analog]]`` tables of the analog a fit describes: its model ``spec``
+    (``"fixed,p1:nospring"``) with ``values`` by dotted name (the fit's, with ``--set``
+    over them). The fixed mass becomes a ``fixed_mass``, each pendulum with its hinge
+    damper and spring a ``spherical_pendulum`` (the lateral fit's planar pendulum swings
+    alike along both lateral axes of an axisymmetric tank).
+
+    Raises
+    ------
+    InputError
+        Naming every value that is missing (the heights and inertias a lateral record does
+        not determine) and every component with no spacecraft form.
+
+    Examples
+    --------
+    >>> analog_tables("fixed,p1:nospring", {"fixed.mass": 1.5, "fixed.height": 0.1,
+    ...     "fixed.inertia": 0.004, "fixed.axial_inertia": 0.006, "p1.mass": 1.3,
+    ...     "p1.length": 0.055, "p1.hinge_height": 0.15, "p1.damping": 0.001})
+    ...                                                  # doctest: +NORMALIZE_WHITESPACE
+    [{'type': 'fixed_mass', 'name': 'fixed', 'mass': 1.5, 'height': 0.1, 'inertia': 0.004,
+      'axial_inertia': 0.006},
+     {'type': 'spherical_pendulum', 'name': 'p1', 'mass': 1.3, 'length': 0.055,
+      'hinge_height': 0.15, 'damping': 0.001}]
+    """
+    from analogs import FixedMass, HingeDamper, HingeSpring, Pendulum
+    from analogs.component import Attachment, Rig
+
+    from .export import export_model
+
+    model, _ = export_model(spec, values)
+    tables: dict[str, dict] = {}
+    problems, missing = [], []
+    for c in model.components:
+        if isinstance(c, Rig):
+            continue
+        if type(c) is FixedMass:
+            tables[c.name] = {"type": "fixed_mass", "name": c.name}
+        elif type(c) is Pendulum:
+            tables[c.name] = {"type": "spherical_pendulum", "name": c.name}
+        elif not isinstance(c, (HingeDamper, HingeSpring, Attachment)):
+            problems.append(f"`{c.name}` ({type(c).__name__}) has no form in a spacecraft file")
+    for c in model.components:
+        if isinstance(c, Attachment) and not isinstance(c, (HingeDamper, HingeSpring)):
+            problems.append(f"`{c.name}` carries a {type(c).__name__}, which the spacecraft's "
+                            "analogs do not have (fit with a linear hinge damper)")
+    for name, table in tables.items():
+        keys = list(_FROM_FIT[table["type"]])
+        springs = any(isinstance(c, HingeSpring) and c.name == name for c in model.components)
+        for key in keys:
+            dotted = f"{name}.{key}"
+            if key == "stiffness" and not springs:
+                continue
+            if dotted in values:
+                table[key] = float(values[dotted])
+            elif key not in ("damping",):
+                missing.append(f"`{dotted}`")
+    if missing:
+        problems.append(f"{source} does not give {', '.join(missing)} (a lateral record does "
+                        "not determine them): give each with --set NAME=VALUE (heights in m "
+                        "above the tank origin, inertias in kg m^2)")
+    if problems:
+        raise InputError(f"--fit: {'; '.join(problems)}")
+    return list(tables.values())
+
+
 def run(args: argparse.Namespace) -> int:
     """Run ``slosh ntc``; returns the exit status."""
     from ..analysis.ntc import nutation_time_constant
 
-    outputs = Outputs(overwrite=args.overwrite, inputs=[args.spacecraft])
+    if args.set and not args.fit:
+        raise InputError("`--set` gives values of a fit's analog: use it with `--fit FIT.json`")
+    outputs = Outputs(overwrite=args.overwrite,
+                      inputs=[args.spacecraft] + ([args.fit] if args.fit else []))
     outputs.file("--json", args.json).check()
-    model, params, options = load_spacecraft(args.spacecraft)
+    analogs = None
+    if args.fit:
+        from ..fitting.record import fit_notes, read_fit
+
+        for note in fit_notes(args.fit, force=args.force):
+            print(f"warning: {note}", file=sys.stderr)
+        fit = read_fit(args.fit)
+        given = assignments(args.set)
+        analogs = analog_tables(fit.model_spec, {**fit.values, **given}, source=str(args.fit))
+        known = {f"{t['name']}.{k}" for t in analogs for k in _FROM_FIT[t["type"]]}
+        unknown = [n for n in given if n not in known]
+        if unknown:
+            raise InputError(f"--set {', '.join(unknown)}: not a value of the analog of "
+                             f"{args.fit} ({fit.model_spec}); it has {', '.join(sorted(known))}")
+        replaced = _analog_count(args.spacecraft)
+        if replaced:
+            print(f"note: {args.spacecraft}: its {replaced} [[analog]] table(s) are replaced by "
+                  f"the analog of {args.fit} ({fit.model_spec})", file=sys.stderr)
+    model, params, options = load_spacecraft(args.spacecraft, analogs=analogs,
+                                             analogs_from=args.fit)
     ntc = nutation_time_constant(model, params, **options)
     print(f"{args.spacecraft}: {model!r}")
     print(ntc.report())
@@ -249,6 +368,8 @@ def run(args: argparse.Namespace) -> int:
            "growth_rate_linearized_per_s": ntc.growth_rate_linearized,
            "nutation_frequency_rad_s": ntc.nutation_frequency,
            "relative_difference": ntc.relative_difference, "grows": ntc.grows}
+    if analogs is not None:
+        out["analog_from_fit"] = {"fit": str(args.fit), "analogs": analogs}
     with outputs.writing() as paths:
         if args.json:
             paths["--json"].write_text(json_text(out))
@@ -256,3 +377,17 @@ def run(args: argparse.Namespace) -> int:
         print("warning: the two methods differ by more than 2 %; simulate longer "
               "([ntc] duration) or with a smaller initial_rate", file=sys.stderr)
     return 0
+
+
+def _analog_count(path: str | Path) -> int:
+    """How many ``[[analog]]`` tables the spacecraft file has (0 when unreadable: the loader
+    says why)."""
+    from ..data.reader import MAX_CASE_FILE_BYTES
+    from ..inputs import load_toml
+
+    try:
+        doc = load_toml(Path(path), "a spacecraft file (TOML)", limit=MAX_CASE_FILE_BYTES)
+    except (OSError, InputError):
+        return 0
+    analogs = doc.get("analog")
+    return len(analogs) if isinstance(analogs, list) else 0

@@ -26,8 +26,9 @@ def add_parser(sub: argparse._SubParsersAction) -> None:
                    help="JSON parameter values: a flat map {\"p1.mass\": 1.3, ...} or a fit result")
     p.add_argument("--out", required=True, help="output CSV (time and the measured channels)")
     p.add_argument("--model", default=None,
-                   help="model specification, e.g. 'fixed,p1,p2' (default: fixed,p1 with hinge "
-                        "spring and damper)")
+                   help="model specification, e.g. 'fixed,p1,p2' (default: the fit's model "
+                        "when --params is a fit result, else fixed,p1 with hinge spring and "
+                        "damper)")
     p.add_argument("--integrator", choices=("rk4", "adaptive"), default="rk4",
                    help="fixed-step RK4 on the sample grid (default) or CVODES")
     p.add_argument("--overwrite", action="store_true", help="replace an existing --out file")
@@ -44,7 +45,7 @@ def run(args: argparse.Namespace) -> int:
     from ..data import load_case
     from ..data.experiment import experiment
     from ..data.models import BASELINE, model_from_spec
-    from ..fitting.params_io import fit_notes, fitted_initial_state, read_params
+    from ..fitting.record import fit_notes, fit_spec, fitted_initial_state, read_params
 
     outputs = Outputs(overwrite=args.overwrite, inputs=[args.case, args.params])
     outputs.file("--out", args.out).check()
@@ -53,7 +54,8 @@ def run(args: argparse.Namespace) -> int:
         print(f"warning: {note}", file=sys.stderr)
     params = read_params(args.params)
     x0 = fitted_initial_state(args.params, case) if case.test.initial_state == "free" else None
-    exp = experiment(case, model_from_spec(BASELINE if args.model is None else args.model, case))
+    spec = args.model or fit_spec(args.params) or BASELINE
+    exp = experiment(case, model_from_spec(spec, case))
     for name, value in exp.fixed.items():  # the rig is the case file's, not the fit's
         given = params.pop(name, value)
         if given != value:

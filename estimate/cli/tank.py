@@ -40,10 +40,17 @@ def add_parser(subparsers: argparse._SubParsersAction) -> None:
     p.add_argument("--density", type=float, default=998.2, help="kg/m^3 (default 998.2)")
     p.add_argument("--viscosity", type=float, default=1.004e-6,
                    help="kinematic viscosity, m^2/s (default 1.004e-6)")
-    p.add_argument("--gravity", type=float, default=9.81, help="axial acceleration, m/s^2")
-    p.add_argument("--method", choices=("exact", "legacy"), default="exact")
+    p.add_argument("--gravity", type=float, default=9.81,
+                   help="axial acceleration, m/s^2 (default 9.81)")
+    p.add_argument("--method", choices=("exact", "legacy"), default="exact",
+                   help="exact: the modal analysis converged to the tank's own shape (Ritz or "
+                        "finite elements, default); legacy: the SLOSH code's Lomen basis, for "
+                        "comparison with its tables (not converged above half full)")
     p.add_argument("--modes", type=int, default=2, help="modes kept as pendulums (default 2)")
-    p.add_argument("--diaphragm", action="store_true", help="flag a diaphragm tank")
+    p.add_argument("--diaphragm", action="store_true",
+                   help="the tank has a diaphragm: the prediction stays the free-surface one "
+                        "and a note says what a diaphragm changes (a higher frequency, a "
+                        "smaller slosh mass, more damping: fit them)")
     p.add_argument("--json", metavar="OUT.json", help="write the prediction as JSON")
     p.add_argument("--plot", metavar="OUT.png",
                    help="plot slosh/fixed mass and frequencies against fill")

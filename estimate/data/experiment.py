@@ -21,7 +21,8 @@ __all__ = ["Experiment", "experiment"]
 
 @dataclass(frozen=True)
 class Experiment:
-    """A case with its derived model and the excitation taken from its data.
+    """A case with its derived model and the excitation taken from its data: ``case``, its
+    ``model`` and that model ``derived``.
 
     ``fixed`` holds the parameter values the case file sets (dry mass, gravity, crank).
     ``make_excitation`` builds :attr:`excitation` when it is first asked for (a fit that
@@ -47,7 +48,8 @@ class Experiment:
     def simulate(self, params: Mapping[str, float], *, x0: Mapping[str, float] | None = None,
                  **options) -> Simulation:
         """Simulate on the case's time grid; ``params`` over the case's rig values, from the
-        case's initial state (:meth:`initial_state`) unless ``x0`` gives it."""
+        case's initial state (:meth:`initial_state`) unless ``x0`` gives it; ``options``
+        are those of :func:`derive.simulate` (``integrator``, ...)."""
         values = {**self.fixed, **params}
         if x0 is None:
             x0 = self.initial_state(values)

@@ -343,11 +343,14 @@ def _open(path: Path, fmt: str, stack) -> tuple[dict[str, _Channel], list[str]]:
 
 def read_lab(path: Path, toml_name: str, doc: Mapping[str, Any], excitation: str | None,
              rig_kind: str | None, rig: Rig | None, problems: list[str], *,
-             uniform: bool = True) -> tuple[Any, ...] | None:
+             uniform: bool = True, unitless: dict[str, str] | None = None
+             ) -> tuple[Any, ...] | None:
     """Read the channels ``[data.columns]`` of the case document ``doc`` names from the lab
     file ``path``; append problems; return ``(time, displacement, force, columns)`` as
     :func:`estimate.data._csv.read_csv` does, or None (``uniform=False``: the time need not
-    be uniform, ``[test] resample_hz``)."""
+    be uniform, ``[test] resample_hz``). ``unitless`` receives the columns read with no
+    unit (neither ``[data.columns]`` nor the file gives one: read as SI), with their
+    channels (:mod:`estimate.data.plausible_units` judges them)."""
     import contextlib
 
     name = path.name
@@ -380,7 +383,7 @@ def read_lab(path: Path, toml_name: str, doc: Mapping[str, Any], excitation: str
             return None
         try:
             out = _read_channels(name, fmt, wanted, channels, listing, rig_kind, rig, problems,
-                                 n_before, uniform)
+                                 n_before, uniform, unitless)
         except Exception as exc:  # noqa: BLE001 - a library failing inside a damaged file
             del problems[n_before:]
             problems.append(f"{name}: not a readable {fmt} file (damaged: reading its channels "
@@ -405,8 +408,8 @@ def _mat5_damage(path: Path) -> str | None:
 
 def _read_channels(name: str, fmt: str, wanted: dict[str, _Spec], channels: dict[str, _Channel],
                    listing: list[str], rig_kind: str | None, rig: Rig | None,
-                   problems: list[str], n_before: int, uniform: bool = True
-                   ) -> tuple[Any, ...] | None:
+                   problems: list[str], n_before: int, uniform: bool = True,
+                   unitless: dict[str, str] | None = None) -> tuple[Any, ...] | None:
     def key(spec: _Spec) -> str:
         return (f"[data.columns] {spec.column}" if spec.explicit else
                 f"column `{spec.column}`, looked up by name without [data.columns]")
@@ -475,6 +478,8 @@ def _read_channels(name: str, fmt: str, wanted: dict[str, _Spec], channels: dict
                 continue
         values[column] = _to_si(raw, unit, target) if unit is not None else raw
         labels[column] = ch.name
+        if unit is None and unitless is not None:
+            unitless[column] = ch.name
     if time_from is not None:
         values["time"] = np.asarray(time_from.time_track(), dtype=float)
         labels["time"] = f"time track of {time_from.name}"

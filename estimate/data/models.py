@@ -22,7 +22,8 @@ from analogs.tank.prediction import MAX_MODES
 
 from .case import Case
 
-__all__ = ["BASELINE", "ROTOR_AXIS", "model_for_case", "model_from_spec", "rig_for", "rig_values"]
+__all__ = ["BASELINE", "ROTOR_AXIS", "model_for_case", "model_from_spec", "model_spec", "rig_for",
+           "rig_values"]
 
 #: Tank axis of rotor analogs on the spinning rig: ``T.y``, the tangential direction (the
 #: way the tank origin moves), about which the nutation drives a rotor (the spin-axis
@@ -118,7 +119,8 @@ def _number_of(name: str, letter: str) -> int | None:
 
 
 def model_from_spec(spec: str, case: Case, *, option: str = "--model") -> Model:
-    """Build a model from a comma-separated specification such as ``"fixed,p1,p2"``.
+    """Build a model from a comma-separated specification ``spec`` such as
+    ``"fixed,p1,p2"``, on the rig of ``case``.
 
     Tokens: ``fixed`` (FixedMass); ``pN`` with N from 1 to ``MAX_MODES`` (6: the modes the
     tank prediction gives initial values for) (Pendulum with HingeSpring and HingeDamper;
@@ -181,3 +183,56 @@ def model_from_spec(spec: str, case: Case, *, option: str = "--model") -> Model:
         raise InputError(f"{option} {spec!r}: " + "; ".join(problems) + "; "
                          + _tokens_text(spinning))
     return model.validate()
+
+
+#: Attachments a ``pN`` token may carry, by modifier (None: always there).
+_ATTACHMENTS = {HingeDamper: None, HingeSpring: "spring", QuadraticDamper: "quadratic",
+                DiaphragmSpring: "diaphragm"}
+
+
+def model_spec(model: Model) -> str | None:
+    """The specification :func:`model_from_spec` builds ``model`` from (``"fixed,p1:nospring"``),
+    or None when the model holds a component the grammar has no token for (a diagnosis's
+    library term, a rig friction, a pendulum under another name).
+
+    Examples
+    --------
+    >>> from analogs import LateralRig, FixedMass, Pendulum, HingeDamper, QuadraticDamper
+    >>> model_spec(LateralRig() + FixedMass("fixed") + Pendulum("p1") + HingeDamper("p1")
+    ...            + QuadraticDamper("p1"))
+    'fixed,p1:nospring:quadratic'
+    """
+    from analogs.component import Attachment
+
+    attached: dict[str, set[str | None]] = {}
+    tokens: list[str] = []
+    for c in model.components:
+        if isinstance(c, Rig):
+            continue
+        if isinstance(c, Attachment):
+            kind = _ATTACHMENTS.get(type(c), "?")
+            if kind == "?":
+                return None
+            attached.setdefault(c.name, set()).add(kind)
+        elif type(c) is FixedMass and c.name == "fixed":
+            tokens.append("fixed")
+        elif type(c) in (Pendulum, SphericalPendulum) and _number_of(c.name, "p"):
+            tokens.append(c.name)
+        elif type(c) is Rotor and (c.name == "rotor" or _number_of(c.name, "r")):
+            tokens.append(c.name)
+        else:
+            return None
+    out = []
+    for tok in tokens:
+        kinds = attached.pop(tok, set())
+        if not tok.startswith("p"):
+            if kinds:
+                return None
+            out.append(tok)
+            continue
+        if None not in kinds:  # every pendulum of the grammar has its hinge damper
+            return None
+        mods = [] if "spring" in kinds else ["nospring"]
+        mods += [m for m in ("quadratic", "diaphragm") if m in kinds]
+        out.append(":".join([tok, *mods]))
+    return ",".join(out) if out and not attached else None

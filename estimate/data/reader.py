@@ -16,6 +16,7 @@ from ._keys import Asked, UnknownKey, unknown_keys
 from ._toml import Checker, read_tables, test_kind
 from .case import Case, CaseError
 from .lab_formats import LAB_SUFFIXES, is_lab_file, read_lab
+from .plausible_units import ImplausibleUnit, unit_warnings
 
 __all__ = ["MAX_CASE_FILE_BYTES", "UnknownKey", "load_case"]
 
@@ -99,6 +100,7 @@ def load_case(path: str | os.PathLike[str], *, strict: bool = False) -> Case:
 
     problems = ck.problems
     notes: list[str] = []
+    unitless: dict[str, str] = {}  # lab-file columns read with no unit, and their channels
     arrays = None
     data_path: Path | None = None
     data_name = t_table.get("data") if isinstance(t_table, Mapping) else None
@@ -124,7 +126,7 @@ def load_case(path: str | os.PathLike[str], *, strict: bool = False) -> Case:
             uniform = not (isinstance(t_table, Mapping) and "resample_hz" in t_table)
             if lab:
                 arrays = read_lab(data_path, fname, doc, excitation, rig_kind, rig, csv_problems,
-                                  uniform=uniform)
+                                  uniform=uniform, unitless=unitless)
             else:
                 arrays = read_csv(data_path, excitation, csv_problems, rig_kind, uniform=uniform)
             problems.extend(csv_problems)
@@ -143,6 +145,9 @@ def load_case(path: str | os.PathLike[str], *, strict: bool = False) -> Case:
         raise CaseError(problems + [u for u in unknown if "did you mean" in u])
     for line in unknown:
         warnings.warn(line, UnknownKey, stacklevel=2)
+    if unitless and rig_kind != "spinning":
+        for line in _unit_warnings(data_path.name, unitless, arrays, tank, liquid, rig):
+            warnings.warn(line, ImplausibleUnit, stacklevel=2)
     assert test is not None and tank is not None and liquid is not None and rig is not None
     assert arrays is not None and data_path is not None
     assert not (pred_present and prediction is None)
@@ -153,6 +158,30 @@ def load_case(path: str | os.PathLike[str], *, strict: bool = False) -> Case:
     return Case(path=toml_path.resolve(), data_path=data_path.resolve(), test=test, tank=tank,
                 liquid=liquid, rig=rig, prediction=prediction, time=time, displacement=disp,
                 force=force, columns=columns, notes=tuple(n for n in notes if n))
+
+
+def _unit_warnings(name: str, unitless: dict[str, str], arrays: tuple, tank, liquid, rig
+                   ) -> list[str]:
+    """What looks wrong about the lab-file columns read with no unit
+    (:func:`estimate.data.plausible_units.unit_warnings`), the force judged against the
+    tank's predicted analog (:func:`analogs.tank.predict`) and the container when weighed."""
+    time, disp, force, _ = arrays
+    modes: list[tuple[float, float, float]] = []
+    rigid = rig.dry_mass or 0.0
+    if "force" in unitless:
+        from analogs.tank import Liquid, predict
+
+        try:
+            pred = predict(tank.geometry(), fill=tank.fill_fraction, gravity=rig.gravity,
+                           liquid=Liquid(density=liquid.density,
+                                         viscosity=liquid.kinematic_viscosity), modes=2)
+        except Exception:  # noqa: BLE001 - a tank the prediction cannot take: not judged
+            unitless = {k: v for k, v in unitless.items() if k != "force"}
+        else:
+            rigid += pred.fixed_mass.mass
+            modes = [(m.mass, m.omega, m.damping_ratio) for m in pred.modes]
+    return unit_warnings(name, list(unitless), time, disp, force, rigid_mass=rigid,
+                         modes=modes, weighed=rig.dry_mass is not None, channels=unitless)
 
 
 def _uniform(name: str, arrays: tuple, rate_hz: float, problems: list[str]

@@ -41,7 +41,7 @@ from derive import derive
 
 from ..data.case import Case
 from ..data.models import model_for_case, model_from_spec, rig_values
-from ..fitting.params_io import read_json
+from ..inputs import load_json
 from .drives import LATERAL_FAMILIES, LateralDrive
 from .problem import MAX_SWING, DesignProblem
 from .report import drive_table, write_drive
@@ -102,7 +102,7 @@ def _spec(parameters: dict, where: str) -> str:
 def rivals_from_diagnosis(path: str | Path, case: Case) -> tuple[Rival, Rival]:
     """The baseline and final models of a diagnosis (the JSON of ``slosh diagnose``) on
     ``case``'s rig, with their estimates."""
-    data = read_json(path, "diagnosis file")
+    data = load_json(path, "a diagnosis file (JSON)")
     out = []
     for label in ("baseline", "final"):
         entry = data.get(label) if isinstance(data, dict) else None
@@ -241,8 +241,8 @@ def _refit(problem: DesignProblem, rivals: tuple[Rival, Rival], r: Rivalry) -> R
 
 @dataclass(frozen=True)
 class Discrimination:
-    """The drive that best tells the two rivals apart, the best of every family, and the
-    figures of each."""
+    """The drive that best tells the two ``rivals`` apart (of the design ``problem``), the
+    best of every family ``ranked``, the ``evaluations`` of the search and its ``seconds``."""
 
     problem: DesignProblem
     rivals: tuple[Rival, Rival]
@@ -280,6 +280,9 @@ class Discrimination:
                 "within the limits and the swing limit"]
 
     def to_dict(self, drive_file: str | None = None) -> dict[str, Any]:
+        """The JSON form of ``slosh design --discriminate --json``; ``drive_file`` names the
+        drive CSV written beside it (None: none)."""
+
         def entry(r: Rivalry) -> dict[str, Any]:
             pk = r.drive.peaks(self.problem.rate)
             return {"label": r.label, "family": r.drive.family, "description": r.drive.describe(),
@@ -300,9 +303,11 @@ class Discrimination:
                 "evaluations": self.evaluations, "seconds": self.seconds}
 
     def write_drive(self, path: Path) -> None:
+        """Write the recommended drive's table as CSV to ``path``."""
         write_drive(path, *drive_table(self.problem, self.recommended.drive))
 
     def plot(self, path: Path) -> None:
+        """Both models' predicted records at the recommended drive, as a PNG at ``path``."""
         from .._plotting import figure, save
 
         p, rec = self.problem, self.recommended
@@ -331,7 +336,9 @@ def discrimination(diagnosis: str | Path, case: Case, *, fit: str | Path,
                    families: tuple[str, ...] | None = None) -> Discrimination:
     """Search the lateral drives for the one that best tells the baseline and final models
     of ``diagnosis`` apart on ``case``'s rig; the noise levels come from the fit ``fit``
-    (the JSON of ``slosh fit``) of the records run so far."""
+    (the JSON of ``slosh fit``) of the records run so far. ``duration`` (s, default the
+    rig's longest record), ``max_swing`` (rad) and ``families`` (default every lateral
+    one) are those of :meth:`DesignProblem.build` and the search."""
     if case.test.rig != "lateral":
         raise InputError(f"{case.path}: discrimination is implemented for the lateral rig; "
                          "on the spinning rig use `--target`")

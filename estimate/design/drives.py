@@ -103,7 +103,8 @@ _FUNCTIONS: dict = {}
 @dataclass(frozen=True)
 class LateralDrive:
     """Base of the lateral-rig drive families: ``duration`` (s) of the record, the amplitude
-    ``scale`` (<= 1) over the levels the limits allow, and the limits themselves.
+    ``scale`` (<= 1) over the levels the limits allow, and the ``limits`` themselves
+    (``[rig.limits]``).
 
     A family defines its design variables and ``_carrier``; the motion of every drive of a
     family comes from one CasADi function of time, scale, variables, limits and duration
@@ -197,7 +198,8 @@ class SteadySine(LateralDrive):
 
 @dataclass(frozen=True)
 class SteppedSine(LateralDrive):
-    """A sine stepped through two frequencies (Hz), each held half the driven time at the
+    """A sine stepped through two frequencies, ``first`` and ``second`` (Hz), each held half
+    the driven time at the
     largest amplitude the limits allow there; phase-continuous smooth changes."""
 
     family: ClassVar[str] = "stepped"
@@ -282,7 +284,7 @@ class SpinDrive:
     ``spin_up`` seconds, then the cone angle ramped from 0 to ``cone_angle`` (rad) over
     ``nutation_ramp`` seconds while the table axis cones at ``nutation_frequency`` (Hz),
     held to the end of the ``duration`` (s) record. The cone angle is the amplitude: it is
-    the largest the limits allow, less what a swing limit asks for (``scale``)."""
+    the largest the ``limits`` allow, less what a swing limit asks for (``scale``)."""
 
     family: ClassVar[str] = "spin"
     variables: ClassVar[tuple[str, ...]] = ("spin_rate", "nutation_frequency")

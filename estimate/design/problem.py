@@ -16,7 +16,7 @@ from derive import DerivedModel, derive
 
 from ..data.case import Case, Limits
 from ..data.models import model_for_case, model_from_spec, rig_values
-from ..fitting.params_io import read_fit, read_json
+from ..fitting.record import read_fit
 from .information import prior_information
 
 __all__ = ["DesignProblem", "CRITERIA", "GOAL", "LINEAR_SWING", "MAX_DESIGN_RATE", "MAX_SWING",
@@ -73,6 +73,13 @@ class DesignProblem:
     record and ``rms`` that record's RMS per channel (the noise of a new record grows with
     its RMS, never below ``noise``); ``displacement_noise`` (m) that of the carriage
     displacement (lateral rig).
+
+    ``case``, ``model`` and its ``derived`` form are those of the next record;
+    ``limits`` the rig's (``[rig.limits]``); ``targets`` the parameters the design is for,
+    scored by ``criterion`` (``"D"`` or ``"A"``); ``channels`` the measured channels;
+    ``duration`` (s) and ``rate`` (Hz) the record's; ``max_swing`` the largest predicted
+    swing (rad); ``frequencies`` the fitted modes' (Hz, by component); ``goal`` the relative
+    interval half-width asked for; ``fit_path`` the fit read; ``notes`` what building said.
     """
 
     case: Case
@@ -144,7 +151,7 @@ class DesignProblem:
             raise InputError(f"--budget {duration:g} s: the rig runs records of at most "
                              f"{limits.duration:g} s (`[rig.limits] duration` of {case.path})")
         fit = read_fit(fit_path)
-        raw = read_json(fit_path, "fit file")
+        raw = fit.data
         model = model_for_case(model_from_spec(fit.model_spec, case), case)
         dm = derive(model)
         names = tuple(n for n in fit.estimated if ":" not in n and n in dm.parameter_names)

@@ -51,7 +51,7 @@ def _correlation(p: Prediction, a: str, b: str) -> float:
 
 @dataclass(frozen=True)
 class Design:
-    """The recommendation of a design: the problem, the search and its findings."""
+    """The recommendation of a design: the ``problem``, the ``search`` and its findings."""
 
     problem: DesignProblem
     search: Search
@@ -142,6 +142,8 @@ class Design:
         return out
 
     def to_dict(self, drive_file: str | None = None) -> dict[str, Any]:
+        """The JSON form of ``slosh design --json``; ``drive_file`` names the drive CSV
+        written beside it (None: none)."""
         p, s = self.problem, self.search
         lim = p.limits
         return {
@@ -192,10 +194,12 @@ class Design:
         return drive_table(self.problem, self.recommended.drive)
 
     def write_drive(self, path: Path) -> None:
-        """Write :meth:`drive_table` as CSV (:func:`write_drive`)."""
+        """Write :meth:`drive_table` as CSV to ``path`` (:func:`write_drive`)."""
         write_drive(path, *self.drive_table())
 
     def plot(self, path: Path) -> None:
+        """The recommended drive and its predicted record, and the families' scores, as a
+        PNG at ``path``."""
         from .._plotting import figure, save
 
         p, rec = self.problem, self.recommended

@@ -49,9 +49,11 @@ LOCAL_EVALUATIONS = 12
 
 @dataclass(frozen=True)
 class Candidate:
-    """A drive scaled to the limits and the swing limit, with its predicted peak swing
-    (rad), what limits its amplitude, the surrogate criterion (drive exact, noise white),
-    and, once judged, the prediction from the fit's own information."""
+    """A ``drive`` scaled to the limits and the swing limit, with its predicted peak
+    ``swing`` (rad), what its amplitude is ``limited_by``, its ``score`` (smaller is
+    better), the ``surrogate`` prediction (drive exact, noise white) from its predicted
+    ``record`` and ``noise`` per channel, and, once judged, the ``prediction`` from the
+    fit's own information; ``label`` names it in reports (a family, an alternative)."""
 
     drive: LateralDrive | SpinDrive
     swing: float
@@ -213,9 +215,9 @@ def band(problem: DesignProblem) -> tuple[float, float]:
 
 @dataclass(frozen=True)
 class Search:
-    """The outcome: the finalists ranked by the fit's prediction (best first), the standard
-    alternatives, the prediction without a new record, the number of drives simulated and
-    the time taken (s)."""
+    """The outcome: the finalists ``ranked`` by the fit's prediction (best first), the
+    standard ``alternatives``, the prediction ``before`` a new record, the ``evaluations``
+    (drives simulated) and the ``seconds`` taken."""
 
     ranked: tuple[Candidate, ...]
     alternatives: tuple[Candidate, ...]
@@ -270,7 +272,8 @@ def family_search(problem: DesignProblem, family, bounds, counter: list[int],
 
 def search(problem: DesignProblem, *, families: tuple[str, ...] | None = None,
            finalists: int = 3) -> Search:
-    """Search every drive family of the rig (lateral: ``families``, default all of
+    """Search every drive family of the rig of the design ``problem`` (lateral:
+    ``families``, default all of
     :data:`~.drives.LATERAL_FAMILIES`), judge the best ``finalists`` and the standard
     alternatives by the fit's information, and rank them (best first)."""
     t0 = time.perf_counter()

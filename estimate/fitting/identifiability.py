@@ -68,8 +68,13 @@ def analyse(covariance: np.ndarray, scales: np.ndarray, names: tuple[str, ...],
         v = V[:, i] ** 2
         members = tuple(names[j] for j in np.argsort(-v) if v[j] >= GROUP_SHARE)
         if len(members) > 1:
+            text = f"relative standard deviation {stds[i]:.2g} along their joint direction"
+            same = next((k for k, g in enumerate(groups) if set(g) == set(members)), None)
+            if same is not None:  # the same estimates along a weaker direction: said once,
+                evidence[same] = text  # with the weakest (stds ascend)
+                continue
             groups.append(members)
-            evidence.append(f"relative standard deviation {stds[i]:.2g} along their joint direction")
+            evidence.append(text)
     if correlation is not None:
         for i in range(len(names)):
             for j in range(i + 1, len(names)):

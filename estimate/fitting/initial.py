@@ -14,7 +14,7 @@ __all__ = ["predicted_values", "predicted_sources", "source_notes", "prediction_
            "length_bounds", "nominal_scale", "tank_prediction", "LENGTH_BAND",
            "PREDICTION_FACTOR"]
 
-#: Pendulum lengths are kept within +/-20 % of the prediction, as the seed did.
+#: Pendulum lengths are kept within +/-20 % of the prediction, as classical slosh-test fits do.
 LENGTH_BAND = 0.20
 
 #: A ``[prediction]`` mass or length more than this factor above or below the tank's own

@@ -39,7 +39,8 @@ class MeasurementModel:
     def term(self, u: ca.DM, inputs: tuple[str, ...], p: Mapping[str, ca.MX],
              t: np.ndarray) -> ca.MX | None:
         """Force (N) added to the simulated force at the sample times ``t`` (s), given the
-        inputs ``u`` there, or ``None``; with :attr:`channels`, a ``samples x channels``
+        values ``u`` there of the rig's ``inputs`` (names) and the parameters ``p`` (CasADi
+        expressions by name), or ``None``; with :attr:`channels`, a ``samples x channels``
         matrix added to those channels."""
         return None
 

@@ -13,7 +13,8 @@ from .. import _plotting as style
 if TYPE_CHECKING:  # pragma: no cover
     from .result import FitResult
 
-__all__ = ["plot_fit", "mode_frequencies", "drive_frequency_of", "noise_density", "spectrum_top"]
+__all__ = ["plot_fit", "mode_frequencies", "drive_frequency_of", "noise_density", "spectrum_top",
+           "trajectory_change"]
 
 
 def mode_frequencies(result: "FitResult") -> dict[str, float]:
@@ -162,15 +163,35 @@ def _spectrum_panel(ax, result, case, t, items, unit: str, drive: float | None,
     ax.legend(loc="upper right", fontsize="small", ncols=2)
 
 
+def trajectory_change(history: np.ndarray, final: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
+    """Each estimate's change from its final value over the iterations, in per cent of that
+    value (``history`` iterations x estimates); an estimate whose final value is 0 (a hinge
+    spring at its bound) in per cent of its largest magnitude instead, which ends at 0 as the
+    others do. Also returns which estimates ended at 0.
+
+    Examples
+    --------
+    >>> change, zero = trajectory_change(np.array([[2.0, 0.5], [1.0, 0.0]]), np.array([1.0, 0.0]))
+    >>> change.tolist(), zero.tolist()
+    ([[100.0, 100.0], [0.0, 0.0]], [False, True])
+    """
+    history = np.asarray(history, float)
+    final = np.asarray(final, float)
+    zero = final == 0
+    peak = np.max(np.abs(history), axis=0) if history.size else np.ones_like(final)
+    scale = np.where(zero, np.where(peak > 0, peak, 1.0), final)
+    return 100.0 * (history - final) / scale, zero
+
+
 def _trajectory_panel(ax, result) -> None:
     from matplotlib.ticker import MaxNLocator, PercentFormatter
 
-    final = np.where(result.values == 0, 1.0, result.values)
-    change = 100.0 * (result.history / final - 1.0)
+    change, zero = trajectory_change(result.history, result.values)
     it = np.arange(change.shape[0])
     for j, name in enumerate(result.names):
+        label = f"{name} (final 0: % of its largest value)" if zero[j] else name
         ax.plot(it, change[:, j], marker="o", ms=3, lw=1.0, color=f"C{j % 10}",
-                ls=("-", "--", ":", "-.")[j // 10 % 4], label=name)
+                ls=("-", "--", ":", "-.")[j // 10 % 4], label=label)
     ax.axhline(0.0, color="0.6", lw=0.5)
     ax.xaxis.set_major_locator(MaxNLocator(integer=True))
     ax.yaxis.set_major_formatter(PercentFormatter())

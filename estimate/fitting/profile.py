@@ -17,7 +17,9 @@ __all__ = ["profile_interval"]
 
 def profile_interval(result: FitResult, name: str, level: float = 0.95, *,
                      max_steps: int = 8) -> tuple[float, float]:
-    """Profile-likelihood interval of the shared estimate ``name``.
+    """Profile-likelihood interval of the shared estimate ``name`` of the fit ``result``, at
+    the confidence ``level`` (default 0.95), each side bracketed in at most ``max_steps``
+    steps.
 
     The profile ``S(v) = min objective with name = v`` (the weighted least-squares objective
     of the fit, carriage motion included) is compared with ``S_hat + s^2 chi2_1(level)``

@@ -54,16 +54,6 @@ def derived_quantities(problem: "FitProblem", theta: np.ndarray, cov: np.ndarray
     return values, {k: unit for k, (_, unit) in found.items()}
 
 
-def _json_number(x: float) -> float | None:
-    """NaN is written as null."""
-    return float(x) if math.isfinite(x) else None
-
-
-def _json_bound(x: float) -> float | None:
-    """Infinite bounds are written as null (JSON has no infinity)."""
-    return float(x) if math.isfinite(x) else None
-
-
 @dataclass(frozen=True)
 class FitResult:
     """The outcome of :func:`estimate.fit`.
@@ -75,7 +65,40 @@ class FitResult:
     also on samples left out by zero weights) and the (filtered) measured force; for a
     multi-channel case (spinning rig) both are ``samples x channels`` arrays, columns
     named by ``channels`` (N and N m);
-    ``history`` the estimates at every IPOPT iteration.
+    ``history`` the estimates at every IPOPT iteration and ``cost_history`` the cost there.
+
+    Attributes
+    ----------
+    problem : FitProblem
+        What was fitted.
+    rms_residual, r_squared : float
+        RMS residual over the fitted samples (N; scaled for several channels) and the
+        share of the measurement's variance the model explains.
+    n_samples, iterations : int
+        Fitted samples, IPOPT iterations.
+    seconds : float
+        Wall time of the fit, s.
+    converged, status : bool, str
+        Whether IPOPT converged, and its status (``"Solve_Succeeded"``).
+    warnings : tuple of str
+        What the fit says about itself (bounds reached, a low R^2, ...).
+    identifiability : Identifiability
+        The scaled sensitivity's conditioning and the confounded groups.
+    derived : dict
+        Derived quantities ``(value, stderr)`` of case 0 (:func:`derived_quantities`).
+    cost_kind, transcription : str
+        The cost (``"squared"``, ``"abs"``) and the transcription used.
+    dof : int
+        Degrees of freedom of the residual (also ``residual_variance``, below).
+    initial_states : tuple of dict
+        Per case, the state at the first sample (see ``initial_state_kinds``).
+    bound_stderr : ndarray or None
+        Per estimate at a bound, the spread the data allow away from it (see ``at_bound``).
+    carriage_coefficients : tuple
+        Per case, the estimated carriage spline's coefficients (see ``states``).
+    covariance_kind : str
+        ``"robust"`` or ``"gauss-newton"``: which covariance ``covariance`` is (see
+        ``robust_covariance`` and ``gauss_newton_covariance``).
     """
 
     problem: "FitProblem" = field(repr=False)
@@ -245,7 +268,7 @@ class FitResult:
         return r / s if r.ndim == 2 else r / s[0]
 
     def channel(self, name: str, case: int = 0) -> tuple[np.ndarray, np.ndarray]:
-        """``(measured, residual)`` of one fitted channel of ``case`` (N or N m)."""
+        """``(measured, residual)`` of the fitted channel ``name`` of ``case`` (N or N m)."""
         names = self.channels[case] if self.channels else ("force_x",)
         if name not in names:
             raise UnknownNameError(f"{name!r} was not fitted; fitted channels: {', '.join(names)}")
@@ -305,9 +328,11 @@ class FitResult:
         return c
 
     def interval(self, name: str, level: float = 0.95) -> tuple[float, float]:
-        """Wald interval from the Gauss-Newton covariance (t distribution); for an estimate
-        at a bound the one-sided interval from the bound (:meth:`one_sided_limit`), up to
-        the other bound when the data do not determine it."""
+        """The ``level`` (default 0.95) interval of the estimate ``name``: the Wald interval
+        from :attr:`stderr` (the covariance ``covariance_kind`` names; t distribution); for
+        an estimate at a bound the one-sided interval from the bound
+        (:meth:`one_sided_limit`), up to the other bound when the data do not determine
+        it."""
         from scipy.stats import t as student
 
         i = self._index(name)
@@ -321,8 +346,8 @@ class FitResult:
         return float(self.values[i] - q * self.stderr[i]), float(self.values[i] + q * self.stderr[i])
 
     def one_sided_limit(self, name: str, level: float = 0.95) -> float | None:
-        """For an estimate at a bound: the one-sided ``level`` confidence limit away from
-        the bound (``bound +/- t_level * bound_stderr``), ``None`` when the data do not
+        """For an estimate ``name`` at a bound: the one-sided ``level`` confidence limit away
+        from the bound (``bound +/- t_level * bound_stderr``), ``None`` when the data do not
         determine it; raises for an estimate inside its bounds."""
         from scipy.stats import t as student
 
@@ -457,183 +482,18 @@ class FitResult:
                          + ". ")
         return text + _PROFILE_HINT
 
-    def _noise_lines(self) -> list[str]:
-        """The noise figure of every fitted channel and the residual over it."""
-        out = []
-        many = len(self.noise_figures) > 1
-        for i, figs in enumerate(self.noise_figures):
-            cid = f"{self.problem.experiments[i].case.test.id}: " if many else ""
-            for c, fig in figs.items():
-                unit = "N m" if c.startswith("torque") else "N"
-                label = c if len(figs) > 1 else "force"
-                out.append(f"    noise figure       = {cid}{label} {fig.describe(unit)}")
-            ratio = self.residual_over_noise(i)
-            if math.isfinite(ratio):
-                out.append(f"    residual / noise   = {cid}{ratio:.3f} (RMS residual on the fitted "
-                           "samples over the noise figure)")
-        return out
-
     # -- output ------------------------------------------------------------------------------
     def to_dict(self) -> dict[str, Any]:
-        """The fixed-key JSON form written by ``slosh fit``."""
-        params: dict[str, Any] = {}
-        free = self.free
-        gn_se, rb_se = self.gauss_newton_stderr, self.robust_stderr
-        for i, (name, v, se, e) in enumerate(zip(self.names, self.values, self.stderr,
-                                                 self.problem.estimated)):
-            params[name] = {"value": float(v), "stderr": float(se) if free[i] else None,
-                            "stderr_gauss_newton": _json_number(gn_se[i]),
-                            "stderr_robust": _json_number(rb_se[i]),
-                            "unit": e.unit, "lower": _json_bound(e.lower),
-                            "upper": _json_bound(e.upper), "estimated": True}
-            if not free[i]:
-                params[name] |= {"at_bound": self.at_bound[i],
-                                 "one_sided_95": self.one_sided_limit(name)}
-        units = {p.name: p.unit for p in self.problem.experiments[0].derived.parameters}
-        for name, (v, se, text) in self.tied().items():
-            params[name] = {"value": v, "stderr": se, "unit": units.get(name, ""),
-                            "estimated": False, "tied": text}
-        needed = set(self.problem.experiments[0].derived.needed_parameters())
-        for name, v in self.problem.fixed[0].items():
-            if name not in params and name in needed and v is not None and math.isfinite(v):
-                params[name] = {"value": float(v), "stderr": None, "unit": units.get(name, ""),
-                                "estimated": False}
-        model = self.problem.model
-        return {
-            "model": model.names,
-            "model_spec": getattr(model, "spec", None) or ",".join(model.names),
-            "cases": [str(e.case.path) for e in self.problem.experiments],
-            "parameters": params,
-            # estimates at a bound have no covariance: both matrices hold the others only
-            "covariance": {"parameters": [n for n, f in zip(self.names, free) if f],
-                           "matrix": self.covariance[np.ix_(free, free)].tolist()},
-            "correlation": self.correlation[np.ix_(free, free)].tolist(),
-            "initial_states": {e.case.test.id: dict(x) for e, x in
-                               zip(self.problem.experiments, self.initial_states)},
-            "initial_state": {e.case.test.id: k for e, k in
-                              zip(self.problem.experiments, self.initial_state_kinds)},
-            "derived": {k: v for k, (v, _) in self.derived.items()},
-            "derived_stderr": {k: se if math.isfinite(se) else None
-                               for k, (_, se) in self.derived.items()},
-            "derived_units": dict(self.derived_units),
-            "cost": self.cost,
-            "rms_residual": self.rms_residual,
-            "r_squared": self.r_squared,
-            "iterations": self.iterations,
-            "seconds": self.seconds,
-            "converged": self.converged,
-            "status": self.status,
-            "verdict": self.verdict,
-            "at_bound": list(self.bounds_reached),
-            "outside_tank": list(self.outside_tank),
-            "first_stage": (None if self.problem.first_stage is None
-                            else self.problem.first_stage.to_dict()),
-            "confounded": self.confounded(),
-            "warnings": list(self.warnings),
-            "input": self.problem.input,
-            "covariance_note": self.covariance_note(),
-            "notes": list(self.problem.notes),
-            "covariance_kind": self.covariance_kind,
-            "covariance_gauss_newton": None if self.gauss_newton_covariance is None else
-            self.gauss_newton_covariance[np.ix_(free, free)].tolist(),
-            "newey_west_lags": list(self.bandwidths),
-            "model_error_factor": self.model_error,
-            "residual_variance": self.residual_variance,
-            "noise_figures": [{c: f.to_dict() for c, f in figs.items()}
-                              for figs in self.noise_figures],
-            "residual_over_noise": [_json_number(self.residual_over_noise(i))
-                                    for i in range(len(self.noise_figures))],
-            "noise": [_noise_dict(ci, rn) for ci, rn in zip(
-                self.problem.carriage or [None] * len(self.problem.experiments),
-                self.problem.noise or [None] * len(self.problem.experiments))],
-        }
+        """The JSON record of the fit (:func:`estimate.fitting.record.fit_record`, the form
+        ``slosh fit --json`` writes, with provenance)."""
+        from .record import fit_record
+
+        return fit_record(self)
 
     def report(self) -> str:
-        """A text fit report: statistics, estimates with intervals, derived quantities,
-        correlations, identifiability, warnings."""
-        single = not self.channels or all(len(c) == 1 for c in self.channels)
-        lines = ["[[Fit statistics]]",
-                 f"    model              = {' + '.join(self.problem.model.names)}",
-                 f"    cases              = {', '.join(e.case.test.id for e in self.problem.experiments)}",
-                 f"    transcription      = {self.transcription}",
-                 f"    solver status      = {self.verdict}",
-                 f"    iterations         = {self.iterations}",
-                 f"    wall time          = {self.seconds:.3f} s",
-                 f"    data points        = {self.n_samples}",
-                 f"    variables          = {len(self.names)}",
-                 f"    cost (sum r^2)     = {self.cost:.6g} {'N^2' if single else '(scaled)'}",
-                 f"    RMS residual       = {self.rms_residual:.6g} {'N' if single else '(scaled)'}",
-                 f"    R^2                = {self.r_squared:.6f}"]
-        lines += self._noise_lines()
-        lines.append("[[Variables]] (95 % intervals from the "
-                     f"{'robust' if self.covariance_kind == 'robust' else 'Gauss-Newton'} "
-                     "covariance; GN: the Gauss-Newton standard error)")
-        for i, (name, v, se, e) in enumerate(zip(self.names, self.values, self.stderr,
-                                                 self.problem.estimated)):
-            if not self.free[i]:
-                lines.append(f"    {name:28s} = {v:.6g} {e.unit} {self.uncertainty_text(i)}  "
-                             f"(init {e.initial:.4g})")
-                continue
-            rel = f"({abs(se / v) * 100:.2f}%)" if v else ""
-            lo, hi = self.interval(name)
-            gn = self.gauss_newton_stderr[i]
-            gn_text = f"  GN +/- {gn:.3g}" if self.covariance_kind == "robust" else ""
-            lines.append(f"    {name:28s} = {v:.6g} {f'+/- {se:.3g}':13s} {rel:10s} {e.unit:12s} "
-                         f"95%: [{lo:.6g}, {hi:.6g}]{gn_text}  (init {e.initial:.4g})")
-        for name, (v, se, text) in self.tied().items():
-            lines.append(f"    {name:28s} = {v:.6g} +/- {se:.3g} (follows: {text})")
-        if self.derived:
-            lines.append("[[Derived]]")
-            for k, (v, se) in self.derived.items():
-                unit = self.derived_units.get(k, "")
-                lines.append(f"    {k:28s} = {v:.6g} +/- {se:.3g} {unit}" if math.isfinite(se)
-                             else f"    {k:28s} = {v:.6g} {unit} (no standard error: it depends "
-                             "on an estimate at a bound)")
-        corr = self.correlation
-        pairs = [(abs(corr[i, j]), self.names[i], self.names[j], corr[i, j])
-                 for i in range(len(self.names)) for j in range(i + 1, len(self.names))]
-        pairs = sorted((p for p in pairs if p[0] > 0.1), reverse=True)  # NaN (at a bound) fails
-        if pairs:
-            lines.append("[[Correlations]] (|C| > 0.1)")
-            for _, a, b, c in pairs:
-                lines.append(f"    C({a}, {b}) = {c:+.4f}")
-        lines.append("[[Identifiability]]")
-        lines.append("    condition number of the scaled sensitivity = "
-                     f"{self.identifiability.condition_number:.3g}")
-        conf = self.confounded()
-        bound = [n for n, f in zip(self.names, self.free) if not f]
-        inside = " inside its bounds" if bound else ""
-        lines += [f"    {c}" for c in conf] or [f"    every estimated parameter{inside} is "
-                                                "determined by the data"]
-        if bound:
-            lines.append(f"    left out (at a bound): {', '.join(f'`{n}`' for n in bound)}")
-        if not single:
-            lines.append("[[Channels]] (residual scale, RMS residual / scale)")
-            for i, names in enumerate(self.channels):
-                r = self.scaled_residuals(i)
-                keep = self.weights[i] > 0 if self.weights else slice(None)
-                for j, c in enumerate(names):
-                    rms = float(np.sqrt(np.mean(r[keep, j] ** 2)))
-                    lines.append(f"    {c:12s} scale {self.channel_scales[i][c]:.4g}  "
-                                 f"RMS residual {rms:.4g}")
-        lines.append("[[Notes]]")
-        lines.append("    " + self.covariance_note())
-        lines += [f"    {n}" for n in self.problem.notes]
-        if self.warnings:
-            lines.append("[[Warnings]]")
-            lines += [f"    {w}" for w in self.warnings]
-        return "\n".join(lines)
+        """A text fit report (:func:`estimate.fitting.record.report_text`): statistics with
+        AIC and BIC, estimates with intervals, derived quantities, correlations,
+        identifiability, notes, warnings."""
+        from .record import report_text
 
-
-def _noise_dict(carriage, noise) -> dict[str, Any] | None:
-    """Noise levels, tones and the carriage estimate's settings of one case, for JSON."""
-    if noise is None:
-        return None
-    out: dict[str, Any] = {"force_noise_N": noise.force_noise, "band_hz": noise.band_hz,
-                           "force_tones": [{"hz": f, "amplitude_N": a} for f, a in noise.tones]}
-    if carriage is not None:
-        out |= {"displacement_noise_m": carriage.displacement_noise,
-                "displacement_tones": [{"hz": f, "amplitude_m": a}
-                                       for f, a in carriage.displacement_tones],
-                "knot_spacing_s": carriage.spline.spacing, "starts_at_rest": carriage.at_rest}
-    return out
+        return report_text(self)

@@ -20,7 +20,7 @@ from derive import RK4, Sine, simulate
 from derive.export_c import has_c_compiler
 from derive.fmu import co_simulate, export_fmu
 from estimate.cli.export import export_model
-from estimate.fitting.params_io import read_params
+from estimate.fitting.record import read_params
 
 fmpy = pytest.importorskip("fmpy", reason="FMU tests need FMPy (extra `fmu`)")
 FMICallException = pytest.importorskip("fmpy.fmi1").FMICallException

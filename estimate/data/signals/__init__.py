@@ -3,13 +3,13 @@
 All functions take uniformly sampled ``time`` [s] and a signal of the same length, and never
 modify their inputs.
 
-* :func:`lowpass` - zero-phase Butterworth low-pass (default 10 Hz, as the seed's workflow),
+* :func:`lowpass` - zero-phase Butterworth low-pass (default 10 Hz, as the classical workflow),
   ``scipy.signal.butter(..., output="sos")`` + ``sosfiltfilt``.
 * :func:`welch_spectrum`, :func:`find_spectral_peaks`, :func:`dominant_frequency` - Welch power
   spectrum and its peaks; each peak frequency is refined by a least-squares sinusoid fit to the
   whole record (a "zoom" around the Welch bin), which resolves a drive frequency to far better
   than 0.1% on a 20-30 s record.
-* :func:`check_drive_frequency` - the seed's data check: the dominant force frequency must match
+* :func:`check_drive_frequency` - the classical data check: the dominant force frequency must match
   the drive frequency within 1.5%.
 * :class:`NoiseFigure`, :func:`quiet_segments`, :func:`segment_noise`,
   :func:`residual_noise` - the noise of a channel inside the signal band, from quiet segments

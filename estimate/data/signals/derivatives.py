@@ -27,7 +27,8 @@ __all__ = ["displacement_derivatives", "motion_band", "significant_frequencies"]
 
 def significant_frequencies(t: NDArray[np.float64], x: NDArray[np.float64], *,
                             derivative: int = 2) -> list[float]:
-    """Frequencies [Hz] of the components of ``x`` whose ``derivative``-th time derivative
+    """Frequencies [Hz] of the components of ``x`` (sampled at the uniform times ``t``, s)
+    whose ``derivative``-th time derivative
     (default 2: the acceleration of a displacement) is >= 1% of the largest; empty when
     ``x`` holds nothing above its noise (a carriage at rest).
 
@@ -58,8 +59,9 @@ def significant_frequencies(t: NDArray[np.float64], x: NDArray[np.float64], *,
 
 
 def motion_band(time: ArrayLike, displacement: ArrayLike) -> float | None:
-    """Highest significant frequency of a carriage motion [Hz] (the top of
-    :func:`significant_frequencies` of the displacement: its acceleration decides), or
+    """Highest significant frequency of a carriage motion [Hz], the ``displacement`` [m]
+    sampled at ``time`` [s] (the top of :func:`significant_frequencies` of the
+    displacement: its acceleration decides), or
     ``None`` when the displacement holds nothing above its noise (the carriage at rest, a
     free decay). It sets the displacement filter's cutoff (:func:`displacement_derivatives`)
     and the estimated carriage spline's knot spacing; a case file's ``[test]

@@ -86,7 +86,7 @@ def lowpass(time: ArrayLike, values: ArrayLike, *, cutoff_hz: float = 10.0, orde
     values : array_like
         The signal (any unit).
     cutoff_hz : float, default 10.0
-        Cutoff frequency [Hz] (the seed's workflow used 10 Hz at 100 Hz sampling).
+        Cutoff frequency [Hz] (the classical filtered-input workflow uses 10 Hz at 100 Hz sampling).
     order : int, default 4
         Butterworth order of one pass.
     ends : {"extend", "odd"}, default "extend"

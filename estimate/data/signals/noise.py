@@ -27,8 +27,9 @@ def _linear_detrend(segments: np.ndarray) -> np.ndarray:
 
 
 def noise_level(time: ArrayLike, values: ArrayLike, *, above_hz: float) -> float:
-    """Standard deviation of the white noise on ``values`` (same unit), from the Welch
-    spectrum between ``above_hz`` and 0.9 times the Nyquist frequency.
+    """Standard deviation of the white noise on ``values`` (same unit; sampled at the
+    uniform ``time``, s), from the Welch spectrum between ``above_hz`` and 0.9 times the
+    Nyquist frequency.
 
     The median PSD of that band is used, so tones (motor, mains) and a few harmonics of the
     signal do not count; a white noise of standard deviation ``s`` has the one-sided PSD
@@ -72,8 +73,9 @@ def _steady(t: np.ndarray, y: np.ndarray, frequency: float) -> bool:
 
 def starts_quiet(time: ArrayLike, values: ArrayLike, noise: float, *,
                  seconds: float = 0.1, factor: float = 3.0) -> bool:
-    """Whether the first ``seconds`` of ``values`` hold nothing but noise of standard
-    deviation ``noise``: their spread about their mean is below ``factor * noise``."""
+    """Whether the first ``seconds`` of ``values`` (sampled at ``time``, s) hold nothing but
+    noise of standard deviation ``noise``: their spread about their mean is below
+    ``factor * noise``."""
     t, y, step = _as_uniform(time, values, "values")
     n = max(int(round(seconds / step)), 8)
     head = y[:n]
@@ -83,8 +85,9 @@ def starts_quiet(time: ArrayLike, values: ArrayLike, noise: float, *,
 def remove_tones(time: ArrayLike, values: ArrayLike, *, above_hz: float,
                  prominence: float = 30.0, max_tones: int = 8
                  ) -> tuple[np.ndarray, tuple[tuple[float, float], ...]]:
-    """``values`` without the spectral lines (motor and electrical tones) above ``above_hz``,
-    and the lines removed as ``(frequency Hz, amplitude)``.
+    """``values`` (sampled at ``time``, s) without the spectral lines (motor and electrical
+    tones) above ``above_hz``, at most ``max_tones`` of them, and the lines removed as
+    ``(frequency Hz, amplitude)``.
 
     A line is a Welch peak above ``above_hz`` whose PSD exceeds ``prominence`` times the
     median PSD of that band and whose amplitude is steady over the record (each quarter's

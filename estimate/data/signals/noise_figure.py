@@ -97,7 +97,8 @@ class NoiseFigure:
     detail: str = ""
 
     def describe(self, unit: str) -> str:
-        """``"0.0119 N (rest before the drive, 0-0.83 s; coloured, AR(4))"``."""
+        """``"0.0119 N (rest before the drive, 0-0.83 s; coloured, AR(4))"``: the figure in
+        ``unit`` (its SI unit, ``"N"``), where it comes from and its colour."""
         colour = f"coloured, AR({len(self.ar)})" if self.ar else "white"
         return f"{self.std:.3g} {unit} ({self.detail}; {colour})"
 
@@ -151,8 +152,9 @@ def _sine_share(t: np.ndarray, y: np.ndarray, top_hz: float, cycles: float = 2.0
 def quiet_segments(time: ArrayLike, displacement: ArrayLike | None, values: ArrayLike, *,
                    displacement_noise: float, band_hz: float, starts_at_rest: bool | None = None
                    ) -> tuple[tuple[int, int], ...]:
-    """Index ranges ``(start, stop)`` of the quiet segments of a record: the rest before the
-    drive and the settled end.
+    """Index ranges ``(start, stop)`` of the quiet segments of a record (``values`` and the
+    ``displacement`` sampled at ``time``, s): the rest before the drive and the settled
+    end.
 
     The carriage is at rest while the ``displacement`` [m] stays within
     :data:`REST_SIGMAS` ``displacement_noise`` [m] of its first (last) value; a segment stops
@@ -261,9 +263,10 @@ def _yule_walker(acov: np.ndarray, n: int) -> tuple[float, ...]:
 
 def segment_noise(time: ArrayLike, values: ArrayLike, segments: tuple[tuple[int, int], ...],
                   *, detail: str = "") -> NoiseFigure:
-    """The noise figure of ``values`` from quiet ``segments`` (index ranges): the standard
-    deviation about each segment's own straight line (offset and drift are not noise; two
-    degrees of freedom per segment), and the AR model of the pooled segments."""
+    """The noise figure of ``values`` (sampled at ``time``, s) from quiet ``segments`` (index
+    ranges): the standard deviation about each segment's own straight line (offset and
+    drift are not noise; two degrees of freedom per segment), and the AR model of the
+    pooled segments; ``detail`` says where they are, for reports."""
     t, y, step = _as_uniform(time, values, "values")
     pieces = [_detrended(y[a:b]) for a, b in segments]
     n = sum(p.size for p in pieces)
@@ -288,8 +291,8 @@ def _expected_median(k: int) -> float:
 def residual_noise(time: ArrayLike, residual: ArrayLike, weights: ArrayLike | None = None, *,
                    segment_seconds: float = 2.0, peaks_below_hz: float | None = None
                    ) -> NoiseFigure:
-    """The noise figure of a fit's ``residual`` (samples with ``weights`` > 0 only): its
-    stationary, broadband part.
+    """The noise figure of a fit's ``residual`` at the sample times ``time`` (s; samples with
+    ``weights`` > 0 only): its stationary, broadband part.
 
     The residual is cut into non-overlapping segments of about ``segment_seconds`` [s]
     (at least 8 segments when the record allows) lying wholly inside the fitted samples; the

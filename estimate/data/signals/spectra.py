@@ -235,7 +235,7 @@ def check_drive_frequency(time: ArrayLike, force: ArrayLike, drive_frequency: fl
                           max_frequency: float | None = None) -> DriveCheck:
     """Check that the dominant force frequency matches the drive frequency.
 
-    The seed's workflow verified that the frequency seen by a spectrum analyser and the measured
+    Classical slosh tests verify that the frequency seen by a spectrum analyser and the measured
     test frequency agree within about 1.5%.
 
     Parameters
@@ -284,7 +284,8 @@ def check_drive_frequency(time: ArrayLike, force: ArrayLike, drive_frequency: fl
 
 
 def drive_frequency(time: ArrayLike, acceleration: ArrayLike) -> tuple[float | None, bool]:
-    """Dominant frequency of a carriage acceleration [Hz], and whether the drive sweeps
+    """Dominant frequency of a carriage ``acceleration`` sampled at ``time`` (s) [Hz], and
+    whether the drive sweeps
     (less than 70 % of the power within +/-10 % of the dominant frequency); ``(None, False)``
     for a signal without power.
 

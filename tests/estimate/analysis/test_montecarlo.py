@@ -173,8 +173,11 @@ def test_cli_export_c_and_fmu(tmp_path, capsys):
     fit = fit_json(tmp_path / "fit.json")
     assert main(["export", str(fit)]) == 2
     assert "nothing to write" in capsys.readouterr().err
-    assert main(["export", str(fit), "--out", str(tmp_path / "c"), "--integrator", "adaptive"]) == 2
-    assert "cannot be generated" in capsys.readouterr().err
+    # only rk4 can be generated as C: the only choice offered
+    with pytest.raises(SystemExit) as stop:
+        main(["export", str(fit), "--out", str(tmp_path / "c"), "--integrator", "adaptive"])
+    assert stop.value.code == 2
+    assert "--integrator: invalid choice: 'adaptive'" in capsys.readouterr().err
     args = ["export", str(fit), "--out", str(tmp_path / "c")]
     if not has_c_compiler():
         args.append("--no-build")

@@ -78,3 +78,7 @@ def test_diagnose_names_the_hidden_mode_in_the_verdict_column(tmp_path):
     assert "(+p2" in verdicts[HIDDEN], verdicts       # a second pendulum is what it lacks
     report = (out / "report" / "report.md").read_text()
     assert f"**{HIDDEN}**" in report and f"diagnosis: {verdicts[HIDDEN]}" in report
+    # what it found, with its numbers (the row and the report)
+    row = next(r for r in read_csv(out / "campaign.csv") if r["id"] == HIDDEN)
+    assert float(row["diagnosed p2.mass [kg]"]) > 0 and float(row["diagnosed p2.mass stderr [kg]"]) > 0
+    assert "`p2.mass`" in report

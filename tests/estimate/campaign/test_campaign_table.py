@@ -151,3 +151,52 @@ def test_closing_as_completed_cancels_tasks_not_started():
     it.close()
     time.sleep(0.2)
     assert len(started) <= 3
+
+
+def test_a_diagnosed_record_row_holds_what_the_diagnosis_found(run):
+    """New-user report defect 10: the row said "slosh_mode (+p2)" without p2's numbers."""
+    import dataclasses
+
+    from estimate.campaign.report import summary
+
+    found = {"status": "ok", "verdict": "slosh_mode (+p2)", "cases": ["b"],
+             "findings": [{"cause": "slosh_mode", "added": ["p2"], "gain": 0.4,
+                           "bic_change": -80.0}],
+             "final_parameters": {"p1.mass": [1.02, 0.01, 1.0, 1.04, "kg"],
+                                  "p2.mass": [0.066, 0.002, 0.062, 0.070, "kg"]},
+             "final_derived": {"p2.frequency_hz": [4.21, 0.01, 4.19, 4.23, "Hz"]}}
+    run = dataclasses.replace(run, diagnoses={**run.diagnoses, "b": found})
+    table = campaign_table(run)
+    row = next(r for r in table.rows if r["id"] == "b")
+    assert row["diagnosed p2.mass [kg]"] == 0.066 and row["diagnosed p2.mass stderr [kg]"] == 0.002
+    assert row["diagnosed p2.frequency_hz [Hz]"] == 4.21
+    assert row["diagnosed p1.mass [kg]"] == 1.02 and row["p1.mass [kg]"] == 1.0  # both fits
+    other = next(r for r in table.rows if r["id"] == "a")
+    assert math.isnan(other["diagnosed p2.mass [kg]"])
+    text = summary(run, table, figures=[])
+    assert "slosh_mode (+p2): `p2.mass` 0.066 +/- 0.002 kg, `p2.frequency_hz` 4.21 +/- 0.01 Hz" \
+        in text
+    # without --diagnose: no such columns
+    plain = campaign_table(dataclasses.replace(run, diagnoses={}))
+    assert not any(c.startswith("diagnosed ") for c, _ in plain.columns)
+
+
+def test_campaign_outputs_get_the_mode_of_any_other_output(run, tmp_path):
+    """New-user report defect 11: campaign.csv/.parquet/.json were 0600, report/ 0700."""
+    import os
+    import stat
+
+    from estimate.campaign.report import claim_folder, write_outputs
+
+    mask = os.umask(0o022)
+    try:
+        out = tmp_path / "out"
+        claim_folder(out, str(tmp_path))
+        write_outputs(run, out)
+    finally:
+        os.umask(mask)
+    modes = {p.relative_to(out).as_posix(): stat.S_IMODE(p.stat().st_mode)
+             for p in [out / "campaign.csv", out / "campaign.parquet", out / "campaign.json",
+                       out / "report", out / "report" / "report.md"]}
+    assert modes == {"campaign.csv": 0o644, "campaign.parquet": 0o644, "campaign.json": 0o644,
+                     "report": 0o755, "report/report.md": 0o644}

@@ -94,3 +94,22 @@ def test_rectangular_tank_in_closed_form(tmp_path, capsys):
     assert data["modes"][0]["frequency_hz"] == pytest.approx(f1, rel=1e-12)
     assert data["liquid_mass"] == pytest.approx(998.2 * 0.4 * 0.2 * h, rel=1e-12)
     assert "closed form" in capsys.readouterr().out
+
+
+def test_the_second_mode_says_its_damping_is_the_first_modes(tmp_path, capsys):
+    """New-user report defect 20: mode 2 got mode 1's damping ratio in silence."""
+    out = tmp_path / "t.json"
+    args = parse(["tank", "--radius", "0.1016", "--fill", "0.6", "--json", str(out)])
+    assert args.run(args) == 0
+    text = capsys.readouterr().out
+    row2 = next(line for line in text.splitlines() if line.split()[:1] == ["2"])
+    assert row2.endswith(" *")
+    assert "* the first mode's value (see the note below)" in text
+    assert "wave/bob: wave height at the wall over the bob's lateral amplitude" in text
+    doc = json.loads(out.read_text())
+    assert doc["modes"][1]["damping_ratio"] == doc["modes"][0]["damping_ratio"]
+    assert any(n.startswith("modes 2 and up: the first mode's damping ratio") for n in doc["notes"])
+    # one mode: nothing to say
+    args = parse(["tank", "--radius", "0.1016", "--fill", "0.6", "--modes", "1"])
+    assert args.run(args) == 0
+    assert "first mode's" not in capsys.readouterr().out

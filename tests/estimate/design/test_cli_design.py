@@ -31,7 +31,7 @@ def _fit_json(path: Path) -> Path:
     R = np.eye(4)
     R[0, 1] = R[1, 0] = -0.995
     cov = R * np.outer(sd, sd)
-    data = {"model_spec": "fixed,p1:nospring",
+    data = {"schema": "slosh-analogs/fit/2", "model_spec": "fixed,p1:nospring",
             "parameters": {n: {"value": v, "stderr": float(s), "unit": "", "estimated": True}
                            for (n, v), s in zip(VALUES.items(), sd)},
             "covariance": {"parameters": names, "matrix": cov.tolist()},

@@ -42,7 +42,7 @@ def test_estimate_at_a_bound_has_no_wald_interval_and_no_correlation(pinned_fit)
     assert all("p1.length" not in g for g in res.identifiability.groups)
     # the report says so instead of printing numbers that look meaningful
     text = res.report()
-    assert re.search(r"p1\.length +=\s+\S+ m at its lower bound [\d.]+ \(one-sided 95 %: <= ", text)
+    assert re.search(r"p1\.length +=\s+\S+ +m +at its lower bound [\d.]+ \(one-sided 95 %: <= ", text)
     assert "left out (at a bound): `p1.length`" in text
     assert not re.search(r"\+/- 0(\s|$)", text)  # no standard error of 0
     assert "p1.frequency_hz" in text and "no standard error: it depends on an estimate at a " \
