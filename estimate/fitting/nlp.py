@@ -224,6 +224,14 @@ def fit(problem: FitProblem, *, transcription: Transcription = MultipleShooting(
         if other is not None:
             return replace(other, iterations=result.iterations + other.iterations,
                            seconds=time.perf_counter() - t_start)
+    if result.converged and result.outside_tank and _free_retry:
+        inside = _inside_the_tank(problem, result, transcription=transcription,
+                                  hessian=hessian, cost=cost, initial_state=initial_state,
+                                  solver_options=solver_options, progress=progress,
+                                  compile_=compile_, balance=balance, _free_retry=False)
+        if inside is not None:
+            return replace(inside, iterations=result.iterations + inside.iterations,
+                           seconds=time.perf_counter() - t_start)
     if not result.converged:
         # a fit that did not converge (its iterations or time budget spent) is no place to
         # read a noise figure or a residual balance from, and a refit would spend the
@@ -275,6 +283,30 @@ def _without_linear_bounds(problem: FitProblem, bounded: FitResult, **options
             "from this minimum; it ends inside the bound")
     return replace(free, problem=replace(free.problem, linear_bounds=problem.linear_bounds,
                                          notes=free.problem.notes + (note,)))
+
+
+def _inside_the_tank(problem: FitProblem, outside: FitResult, **options) -> FitResult | None:
+    """The fit of ``problem`` with the tank's ranges (:attr:`FitProblem.tank_ranges`) as
+    bounds, started from ``outside`` (a converged fit that put the analog outside its tank)
+    moved inside them; ``None`` when it does not converge.
+
+    The ranges are not bounds of every fit (any finite bound sent a six-channel rotor fit
+    from the prediction astray), but a fit that left them trades a poorly determined
+    quantity into an impossible one: a spinning-rig candidate with a rotary oscillator
+    fitted the torques to 0.013 N m with the fixed mass's inertias at 1.1 and 2.5 kg m^2
+    (the whole liquid's at the wall: 0.15 kg m^2)."""
+    ranges = problem.tank_ranges
+    est = tuple(replace(e, lower=max(e.lower, ranges[e.parameter][0]),
+                        upper=min(e.upper, ranges[e.parameter][1]))
+                if e.parameter in ranges else e for e in problem.estimated)
+    bounded = replace(problem, estimated=est).with_initial(dict(zip(outside.names,
+                                                                    outside.values)))
+    res = fit(bounded, warm_start=outside, robust_start=False, **options)
+    if not res.converged:
+        return None
+    note = ("the analog left its tank in a fit without the tank's ranges as bounds ("
+            + "; ".join(outside.outside_tank) + "); refitted within them")
+    return replace(res, problem=replace(res.problem, notes=res.problem.notes + (note,)))
 
 
 def _setup(problem: FitProblem, transcription: Transcription, cost: str, kinds: list[str],

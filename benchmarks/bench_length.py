@@ -1,0 +1,103 @@
+"""Benchmark of fit cost against record length (issue 27): rig-rate records from rest.
+
+Run: ``python benchmarks/bench_length.py [--max-samples N]``. Records from the independent
+reference simulator (``tests/reference_models.py``): the 8-inch sphere at 60 % fill (the
+bundled example's analog), a 1 mm carriage sweep 0.6-1.6 f1 faded in over 1.5 s from rest,
+displacement noise 2e-5 m, force noise 1.3 % of its RMS; 3,001 / 10,001 / 30,001 samples at
+500 Hz and 120,001 / 600,001 at 1 kHz (2 and 10 minutes). Each record is written once into
+``benchmarks/.records/`` (SYNTHETIC data; kept between runs, the reference simulation of the
+longest takes minutes) and fitted in a NEW process (`slosh fit`'s default model, estimated
+input), so that its peak memory is its own.
+
+Printed per row: samples, wall and CPU time of build + fit, IPOPT iterations, peak resident
+memory and its growth per sample over the process after imports (KiB), the time per sample
+as a ratio to the 3,001-sample row, and every estimate's error against the truth in its
+standard errors (z). The SciPy peer on the 3,001-sample records is ``bench_fit.py``'s.
+"""
+
+import argparse
+import json
+import subprocess
+import sys
+from pathlib import Path
+
+import _common  # noqa: F401  (pins threads before numpy is imported)
+
+ROOT = Path(__file__).resolve().parents[1]
+RECORDS = Path(__file__).resolve().parent / ".records"
+#: (duration s, rate Hz) of the rows.
+ROWS = ((6.0, 500.0), (20.0, 500.0), (60.0, 500.0), (120.0, 1000.0), (600.0, 1000.0))
+TRUTH = {"fixed.mass": 1.5, "p1.mass": 1.30, "p1.length": 0.0553}
+
+_MAKE = """
+import sys
+sys.path.insert(0, {root!r}); sys.path.append({tests!r})
+from pathlib import Path
+import numpy as np
+import reference_models as ref
+from synthetic_cases import G, make_case, pendulum
+from estimate.data.case import Prediction
+p = pendulum(1.30, 0.0553, 0.01)
+f1 = ref.natural_frequency(p, G) / (2 * np.pi)
+drive = ref.Ramped(ref.LinearSweep(0.001, 0.6 * f1, 1.6 * f1, {duration}), 1.5, 0.0)
+make_case(Path({folder!r}), {name!r}, drive, pendulums=[p], fixed_mass=1.5, dry_mass=1.2,
+          noise=0.013, displacement_noise=2e-5, duration={duration}, rate={rate}, seed=4,
+          prediction=Prediction(1.338, 0.057, 1.456, 0.007))
+"""
+
+_FIT = """
+import json, resource, sys, time
+sys.path.insert(0, {root!r})
+from estimate import FitProblem, fit, load_case, model_from_spec
+case = load_case({path!r})
+base = resource.getrusage(resource.RUSAGE_SELF).ru_maxrss
+t, c = time.perf_counter(), time.process_time()
+res = fit(FitProblem.build(case, model_from_spec("fixed,p1", case)), progress=False)
+wall, cpu = time.perf_counter() - t, time.process_time() - c
+peak = resource.getrusage(resource.RUSAGE_SELF).ru_maxrss
+print(json.dumps({{"n": int(case.time.size), "wall": wall, "cpu": cpu, "it": res.iterations,
+                  "status": res.status, "peak_kib": peak, "base_kib": base,
+                  "values": dict(zip(res.names, map(float, res.values))),
+                  "stderr": dict(zip(res.names, map(float, res.stderr)))}}))
+"""
+
+
+def record(duration: float, rate: float) -> Path:
+    """The record's case file, made once."""
+    name = f"sweep_{int(duration)}s_{int(rate)}Hz"
+    path = RECORDS / f"{name}.toml"
+    if not path.exists():
+        RECORDS.mkdir(exist_ok=True)
+        code = _MAKE.format(root=str(ROOT), tests=str(ROOT / "tests"), folder=str(RECORDS),
+                            name=name, duration=duration, rate=rate)
+        subprocess.run([sys.executable, "-c", code], check=True)
+    return path
+
+
+def main() -> None:
+    ap = argparse.ArgumentParser(description=__doc__.splitlines()[0])
+    ap.add_argument("--max-samples", type=int, default=700_000,
+                    help="skip the rows longer than this many samples")
+    args = ap.parse_args()
+    rows = []
+    print("| samples | wall s | CPU s | iterations | peak MB | KiB/sample | CPU/sample vs 3k | "
+          "z: fixed, p1 mass, p1 length |")
+    print("|---|---|---|---|---|---|---|---|")
+    for duration, rate in ROWS:
+        if duration * rate + 1 > args.max_samples:
+            continue
+        path = record(duration, rate)
+        out = subprocess.run([sys.executable, "-c", _FIT.format(root=str(ROOT), path=str(path))],
+                             check=True, capture_output=True, text=True).stdout
+        r = json.loads(out.strip().splitlines()[-1])
+        rows.append(r)
+        per = r["cpu"] / r["n"]
+        ratio = per / (rows[0]["cpu"] / rows[0]["n"])
+        z = ", ".join(f"{(r['values'][k] - v) / r['stderr'][k]:+.1f}" for k, v in TRUTH.items())
+        print(f"| {r['n']:,} | {r['wall']:.2f} | {r['cpu']:.2f} | {r['it']} | "
+              f"{r['peak_kib'] / 1024:.0f} | {(r['peak_kib'] - r['base_kib']) / r['n']:.1f} | "
+              f"{ratio:.2f} | {z} |", flush=True)
+
+
+if __name__ == "__main__":
+    main()
