@@ -166,7 +166,7 @@ class Model:
 
     def explicit_values(self) -> dict[str, float]:
         """Parameter values given explicitly to component constructors (not declared defaults)."""
-        return {f"{c.prefix}.{k}": v for c in self._components for k, v in c._values.items()}
+        return {f"{c.prefix}.{k}": v for c in self._components for k, v in c.given_values.items()}
 
     def resolve(self, values: Mapping[str, float] | None = None) -> dict[str, float | None]:
         """Parameter values: ``values`` over defaults, checked against names and bounds.

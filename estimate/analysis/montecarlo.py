@@ -148,7 +148,7 @@ def _run_task(task: _Task, shared: str) -> np.ndarray:
     if fn is None:
         fn = ca.Function.deserialize(shared)
         if task.compile:
-            from derive._compile import compiled
+            from derive import compiled
 
             fn = compiled(fn)
         _WORKER_CACHE[task.key] = fn

@@ -63,18 +63,18 @@ def model_for_case(model: Model, case: Case) -> Model:
     rig = model.rig
     spin = case.rig.spin
     if isinstance(rig, SpinningRig) and spin is not None and rig.motion != spin.motion:
-        keep = {k: v for k, v in rig._values.items() if k in ("dry_mass", "radius", "height",
+        keep = {k: v for k, v in rig.given_values.items() if k in ("dry_mass", "radius", "height",
                                                                 "gravity")}
         return model.replace(SpinningRig(gravity=rig.with_gravity, tank_axis=rig.tank_axis,
                                          motion=spin.motion, name=rig.name,
-                                         bounds={k: v for k, v in rig._bounds.items() if k in keep},
+                                         bounds={k: v for k, v in rig.given_bounds.items() if k in keep},
                                          **keep))
     if isinstance(rig, LateralRig) and case.test.rig == "lateral" \
             and rig.excitation != case.test.excitation:
         shared = {"dry_mass", "gravity"}  # what both excitations of the rig have
         swapped = LateralRig(excitation=case.test.excitation, name=rig.name,
-                             bounds={k: v for k, v in rig._bounds.items() if k in shared},
-                             **{k: v for k, v in rig._values.items() if k in shared})
+                             bounds={k: v for k, v in rig.given_bounds.items() if k in shared},
+                             **{k: v for k, v in rig.given_values.items() if k in shared})
         return model.replace(swapped)
     return model
 

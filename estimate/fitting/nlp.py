@@ -314,7 +314,7 @@ def _setup(problem: FitProblem, transcription: Transcription, cost: str, kinds: 
     """The assembled NLP of ``problem`` and its per-case terms (``kinds``: each case's
     initial state, "rest", "steady" or "free")."""
     if compile_ is None:
-        from derive._compile import c_compiler
+        from derive import c_compiler
 
         compile_ = blocks_ok and c_compiler() is not None
     scales = np.array([e.scale for e in problem.estimated])
