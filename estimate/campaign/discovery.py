@@ -38,7 +38,7 @@ from analogs.errors import InputError
 from ..data.case import SHAPE_KEYS
 from ..data.models import BASELINE
 from ..data.reader import MAX_CASE_FILE_BYTES
-from ..fitting.problem import INPUT_MODES
+from ..fitting.strategies import DEFAULT_INPUT, INPUT_MODES
 from ..inputs import file_kind, load_toml, open_input
 
 __all__ = ["CAMPAIGN_FILE", "Campaign", "Group", "Record", "Setup", "discover"]
@@ -331,7 +331,7 @@ def _settings(path: Path, records: tuple[Record, ...]) -> tuple[dict[str, Any], 
         if not isinstance(settings[key], str):
             problems.append(f"{fname}: [campaign] {key}: expected a string, found "
                             f"{settings[key]!r}")
-    if settings.get("input", "estimated") not in INPUT_MODES:
+    if settings.get("input", DEFAULT_INPUT.name) not in INPUT_MODES:
         problems.append(f"{fname}: [campaign] input: expected one of "
                         f"{', '.join(INPUT_MODES)}, found {settings['input']!r}")
     if isinstance(settings.get("model"), str):
@@ -367,18 +367,15 @@ def _nearest(key: str, known: set[str], *, table: bool = False) -> str:
 def _spec_problems(spec: str, where: str, records) -> list[str]:
     """Why the model specification ``spec`` (from ``where``) cannot be built for the rigs of
     ``records`` (checked at discovery, so that the key that gave it is named)."""
-    from types import SimpleNamespace
-
-    from ..data.models import model_from_spec
+    from analogs import LateralRig, SpinningRig
+    from analogs.spec import model_from_spec
 
     rigs = sorted({r.setup.rig for r in records if r.setup is not None} & {"lateral", "spinning"})
-    spin = SimpleNamespace(gravity_on=True, tank_axis="spin", motion="constant")
     for rig in rigs or ["lateral"]:
-        stub = SimpleNamespace(test=SimpleNamespace(rig=rig, excitation="spin" if rig == "spinning"
-                                                    else "measured"),
-                               rig=SimpleNamespace(spin=spin), path=where)
+        on = (SpinningRig(gravity=True, tank_axis="spin", motion="constant") if rig == "spinning"
+              else LateralRig(excitation="measured"))
         try:
-            model_from_spec(spec, stub, option=where)
+            model_from_spec(spec, on, option=where)
         except InputError as err:
             return [str(err)]
     return []
@@ -439,5 +436,5 @@ def discover(source: str, *, model: str | None = None) -> Campaign:
         groups = tuple(Group(g.name, g.records, model) for g in groups)
     return Campaign(source=str(source), root=root, title=settings.get("title", ""),
                     note=settings.get("note", ""), model=spec,
-                    input=settings.get("input", "estimated"), records=records, groups=groups,
+                    input=settings.get("input", DEFAULT_INPUT.name), records=records, groups=groups,
                     skipped=skipped)
