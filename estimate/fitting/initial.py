@@ -71,12 +71,15 @@ def case_prediction(case: Case, modes: int):
         _PREDICTIONS[key] = entry
     kept = entry[1]
     if modes not in kept:
-        kept[modes] = tank_prediction(case.tank.geometry(), case.tank.fill_fraction,
-                                      density=case.liquid.density,
-                                      viscosity=case.liquid.kinematic_viscosity,
-                                      gravity=case.rig.gravity, modes=modes,
-                                      diaphragm=case.tank.diaphragm)
+        kept[modes] = _tank_prediction(case, modes)
     return kept[modes]
+
+
+def _tank_prediction(case: Case, modes: int):
+    return tank_prediction(case.tank.geometry(), case.tank.fill_fraction,
+                           density=case.liquid.density,
+                           viscosity=case.liquid.kinematic_viscosity, gravity=case.rig.gravity,
+                           modes=modes, diaphragm=case.tank.diaphragm)
 
 
 def prediction_conflicts(case: Case, *, factor: float = PREDICTION_FACTOR) -> list[str]:
