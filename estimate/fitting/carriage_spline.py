@@ -133,8 +133,8 @@ class CarriageInput:
     coloured_noise : bool
         The displacement's noise is not white: the least-squares spline misses the record
         by more than :data:`~estimate.fitting.carriage.COLOURED_FACTOR` times the white
-        level above the band (a displacement integrated from an accelerometer: its noise grows towards low
-        frequencies), so ``displacement_noise`` is that misfit's standard deviation
+        level above the band (a displacement integrated from an accelerometer: its noise
+        grows towards low frequencies), so ``displacement_noise`` is that misfit's standard deviation
         (``n - coefficients`` degrees of freedom).
     """
 
