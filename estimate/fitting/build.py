@@ -66,7 +66,7 @@ def raise_all(problems: Sequence[InputError]) -> None:
 
 def checked_arguments(cases: Case | Sequence[Case], *, hold, initial, bounds, force_cutoff_hz,
                       weights, channel_weights, input, lag, start) -> Arguments:
-    """Step 1: the arguments, every problem reported at once."""
+    """The arguments, every problem reported at once."""
     cases = (cases,) if isinstance(cases, Case) else tuple(cases)
     if not cases:
         raise InputError("no cases to fit")
@@ -105,7 +105,7 @@ def checked_arguments(cases: Case | Sequence[Case], *, hold, initial, bounds, fo
 
 
 def experiments(cases: Sequence[Case], model: Model) -> tuple[Experiment, ...]:
-    """Step 2: each case with the model on its own rig (a measured and a crank case share
+    """Each case with the model on its own rig (a measured and a crank case share
     the physical parameters)."""
     return tuple(experiment(c, model_for_case(model, c)) for c in cases)
 
@@ -120,7 +120,7 @@ def model_parameters(exps: Sequence[Experiment], measurement: Sequence) -> dict:
 
 def name_problems(args: Arguments, estimate: Sequence[str] | None, params: Mapping,
                   exps: Sequence[Experiment], measurement: Sequence) -> list[InputError]:
-    """Step 4: the names the arguments give that the problem does not have (parameters,
+    """The names the arguments give that the problem does not have (parameters,
     channels), parameters both estimated and held, cases that measure nothing the model
     outputs, lateral-force measurement models on multi-channel cases."""
     problems: list[InputError] = []
@@ -157,7 +157,7 @@ def name_problems(args: Arguments, estimate: Sequence[str] | None, params: Mappi
 
 def estimated_names(estimate: Sequence[str] | None, args: Arguments,
                     exps: Sequence[Experiment], measurement: Sequence) -> tuple[list[str], list[str]]:
-    """Step 5: the parameters to estimate and notes: the user's, or every parameter the
+    """The parameters to estimate and notes: the user's, or every parameter the
     equations and the measured outputs need less the rig values the case files fix, the
     held ones and the masses a free decay cannot determine."""
     if estimate is not None:
@@ -172,7 +172,7 @@ def estimated_names(estimate: Sequence[str] | None, args: Arguments,
 
 def start_values(params: Mapping, args: Arguments, explicit: Mapping[str, float],
                  predicted: Mapping[str, float]) -> dict[str, float]:
-    """Step 6: every parameter's start value: the user's initial value > a held value > a
+    """Every parameter's start value: the user's initial value > a held value > a
     value given to a constructor > the prediction > the declared default."""
     start: dict[str, float] = {}
     for n in params:
@@ -184,11 +184,72 @@ def start_values(params: Mapping, args: Arguments, explicit: Mapping[str, float]
     return start
 
 
+@dataclass(frozen=True)
+class Start:
+    """Where the estimates start (:func:`starting_point`): the estimated names less the
+    tied ones, every parameter's start value, the prediction, the liquid budget's ties and
+    linear bounds, the names whose values the user or a constructor gave, and the first
+    stage's values."""
+
+    names: list[str]
+    values: dict[str, float]
+    predicted: dict[str, float]
+    ties: tuple
+    linear: tuple
+    tied: set[str]
+    given: set[str]
+    stage_start: dict[str, float]
+
+
+def starting_point(args: Arguments, model: Model, exps: Sequence[Experiment], params: Mapping,
+                   names: list[str], stage, stage_note: str | None, lag_note: str | None,
+                   notes: list[str]) -> Start:
+    """Where the estimates start: the prediction (tank modal analysis or
+    ``[prediction]``, computed once per case), the values given, the liquid budget's ties,
+    an unweighed container's guess, the first stage's values; raises naming every
+    estimate without a start. Appends its notes to ``notes``."""
+    cases, hold = args.cases, args.hold
+    predicted, sources, failure = predicted_sources(cases[0], model, names)
+    explicit = model.explicit_values()
+    start = start_values(params, args, explicit, predicted)
+    ties, linear, budget_notes = liquid_budget(cases, model, names, start)
+    tied = {t.parameter for t in ties}
+    names = [n for n in names if n not in tied]
+    notes += budget_notes
+    if "rig.dry_mass" in names and "rig.dry_mass" not in start:
+        # an unweighed container: a start of the liquid's order (fit's first stage refines it)
+        start["rig.dry_mass"] = container_guess(cases[0])
+        sources = {**sources, "rig.dry_mass": "a guess (the liquid mass)"}
+    given = set(args.initial) | set(hold) | set(explicit)
+    stage_start = {}
+    if stage is not None:
+        from .first_stage import starting_values
+
+        stage_start = {k: v for k, v in starting_values(
+            stage, gravity=cases[0].rig.gravity, estimated=names,
+            values={**start, **exps[0].fixed},
+            liquid_mass=liquid_or_none(cases[0])).items() if k not in given}
+        start |= stage_start
+        sources = {**sources, **dict.fromkeys(stage_start, "the first stage")}
+        notes.append(stage.describe())
+    notes += [n for n in (stage_note, lag_note) if n]
+    missing = [n for n in names if n not in start]
+    if missing:
+        why = failure or ("neither `[prediction]` nor the tank modal analysis supplies "
+                          "them (they give masses, lengths, heights and inertias of the "
+                          "fixed mass and the pendulums)")
+        raise InputError(
+            f"no initial value for {', '.join(f'`{n}`' for n in missing)}: {why}; give them "
+            f"with `initial` (e.g. `FitProblem.build(..., initial={{'{missing[0]}': ...}})`)")
+    notes += source_notes(sources, [n for n in names if n not in given])
+    return Start(names, start, predicted, ties, linear, tied, given, stage_start)
+
+
 def estimates(names: Sequence[str], params: Mapping, args: Arguments, start: Mapping[str, float],
               predicted: Mapping[str, float], stage_start: Mapping[str, float], given: set,
               stage, exps: Sequence[Experiment], per_case_names: set, per_case: Sequence[str],
               gravity: float, notes: list[str]) -> list:
-    """Step 8: the :class:`~estimate.fitting.problem.Estimated` parameters with start,
+    """The :class:`~estimate.fitting.problem.Estimated` parameters with start,
     bounds (pendulum lengths within the prediction's band) and scale; per-case ones once
     per case that has them. Appends its notes to ``notes``."""
     from .problem import Estimated
@@ -226,8 +287,12 @@ def estimates(names: Sequence[str], params: Mapping, args: Arguments, start: Map
 def build_problem(cls, cases: Case | Sequence[Case], model: Model, *,
                   estimate: Sequence[str] | None, hold, initial, bounds, force_cutoff_hz,
                   measurement: Sequence, weights, channel_weights, input, lag, start):
-    """The stages of :meth:`FitProblem.build` (its docstring gives the arguments); ``cls``
-    is the problem class."""
+    """:meth:`FitProblem.build` (its docstring gives the arguments) in named steps:
+    :func:`checked_arguments`, :func:`experiments`, the input mode's carriage and noise
+    (:func:`~estimate.fitting.input_noise.input_estimation`), the first stage and the
+    stream lag (:mod:`estimate.fitting.starts`), :func:`name_problems`,
+    :func:`estimated_names`, :func:`starting_point`, :func:`estimates`, the spinning rig's
+    stage, the values held; ``cls`` is the problem class."""
     from .problem import PER_CASE
 
     args = checked_arguments(cases, hold=hold, initial=initial, bounds=bounds,
@@ -251,39 +316,9 @@ def build_problem(cls, cases: Case | Sequence[Case], model: Model, *,
     notes = [n for c in cases for n in c.notes]  # what loading did to the records
     names, rest_notes = estimated_names(estimate, args, exps, measurement)
     notes += rest_notes
-    predicted, sources, failure = predicted_sources(cases[0], model, names)
-    explicit = model.explicit_values()
-    start = start_values(params, args, explicit, predicted)
-    ties, linear, budget_notes = liquid_budget(cases, model, names, start)
-    tied = {t.parameter for t in ties}
-    names = [n for n in names if n not in tied]
-    notes += budget_notes
-    if "rig.dry_mass" in names and "rig.dry_mass" not in start:
-        # an unweighed container: a start of the liquid's order (fit's first stage refines it)
-        start["rig.dry_mass"] = container_guess(cases[0])
-        sources = {**sources, "rig.dry_mass": "a guess (the liquid mass)"}
-    given = set(args.initial) | set(hold) | set(explicit)
-    stage_start = {}
-    if stage is not None:
-        from .first_stage import starting_values
-
-        stage_start = {k: v for k, v in starting_values(
-            stage, gravity=cases[0].rig.gravity, estimated=names,
-            values={**start, **exps[0].fixed},
-            liquid_mass=liquid_or_none(cases[0])).items() if k not in given}
-        start |= stage_start
-        sources = {**sources, **dict.fromkeys(stage_start, "the first stage")}
-        notes.append(stage.describe())
-    notes += [n for n in (stage_note, lag_note) if n]
-    missing = [n for n in names if n not in start]
-    if missing:
-        why = failure or ("neither `[prediction]` nor the tank modal analysis supplies "
-                          "them (they give masses, lengths, heights and inertias of the "
-                          "fixed mass and the pendulums)")
-        raise InputError(
-            f"no initial value for {', '.join(f'`{n}`' for n in missing)}: {why}; give them "
-            f"with `initial` (e.g. `FitProblem.build(..., initial={{'{missing[0]}': ...}})`)")
-    notes += source_notes(sources, [n for n in names if n not in given])
+    st = starting_point(args, model, exps, params, names, stage, stage_note, lag_note, notes)
+    names, start, predicted, tied, given = st.names, st.values, st.predicted, st.tied, st.given
+    ties, linear, stage_start = st.ties, st.linear, st.stage_start
     g = cases[0].rig.gravity
     inside = tank_ranges(cases[0], model, names, {
         n: length_bounds(v)[1] for n, v in predicted.items() if n.endswith(".length")})
