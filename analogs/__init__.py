@@ -21,6 +21,7 @@ from .rigs import LateralRig, crank_displacement
 from .rotary import RotaryOscillator, ThreeDofPendulum
 from .rotor import Rotor
 from .spacecraft import FreeSpacecraft, body_angular_velocity
+from .spec import model_from_spec, spec_of
 from .spinning import SpinningRig
 from .suspended_mass import SuspendedMass
 from .vehicle import VehicleFrame
@@ -57,4 +58,6 @@ __all__ = [
     "VehicleFrame",
     "body_angular_velocity",
     "crank_displacement",
+    "model_from_spec",
+    "spec_of",
 ]

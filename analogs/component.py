@@ -160,6 +160,19 @@ class Component:
         """Human-readable identification used in error messages."""
         return f"{type(self).__name__}({self.name!r})"
 
+    @property
+    def given_values(self) -> dict[str, float]:
+        """Parameter values given to the constructor (SI units), by local name: a copy,
+        without the declared defaults (``Pendulum("p1", length=0.05).given_values`` is
+        ``{"length": 0.05}``)."""
+        return dict(self._values)
+
+    @property
+    def given_bounds(self) -> dict[str, tuple[float, float]]:
+        """Bounds given to the constructor (``bounds=``), by local name: a copy, without
+        the declared physical bounds."""
+        return dict(self._bounds)
+
     def parameter(self, local: str) -> Parameter:
         """The bound :class:`Parameter` called ``local`` (e.g. ``"length"``)."""
         spec = self.parameters[local]

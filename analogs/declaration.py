@@ -15,7 +15,11 @@ from sympy.physics import mechanics as me
 
 from .errors import InputError
 
-__all__ = ["Namespace", "Declaration", "FrameDeclaration", "PointMass", "Body"]
+__all__ = ["Namespace", "Declaration", "FrameDeclaration", "PointMass", "Body", "Collected", "Frames", "TIME"]
+
+#: Time (s), the variable of every dynamic symbol (SymPy's ``dynamicsymbols`` time: the same
+#: cached symbol).
+TIME: sp.Symbol = sp.Symbol("t")
 
 
 class Namespace(Mapping[str, Any]):
@@ -67,7 +71,12 @@ class Body:
 
 
 @dataclass
-class _Collected:
+class Collected:
+    """What the components of a model declare, gathered for the derivation
+    (:mod:`derive`): point masses, rigid bodies, potential energy terms (J), Rayleigh
+    dissipation terms (W / 2) and generalized forces ``(force, coordinate)``. A
+    :class:`Declaration` appends to it; the derivation reads it."""
+
     particles: list[PointMass] = field(default_factory=list)
     bodies: list[Body] = field(default_factory=list)
     potential: list[sp.Expr] = field(default_factory=list)
@@ -76,7 +85,7 @@ class _Collected:
 
 
 class _Base:
-    def __init__(self, owner: str, shared: "_Shared", collected: _Collected) -> None:
+    def __init__(self, owner: str, shared: "Frames", collected: Collected) -> None:
         self._owner = owner
         self._shared = shared
         self._collected = collected
@@ -84,7 +93,7 @@ class _Base:
     @property
     def t(self) -> sp.Symbol:
         """Time (s)."""
-        return me.dynamicsymbols._t
+        return TIME
 
     @property
     def inertial(self) -> me.ReferenceFrame:
@@ -117,8 +126,8 @@ class _Base:
 class FrameDeclaration(_Base):
     """What a rig declares: the tank frame's motion, its input signals and gravity."""
 
-    def __init__(self, owner: str, params: Mapping[str, sp.Symbol], shared: "_Shared",
-                 collected: _Collected) -> None:
+    def __init__(self, owner: str, params: Mapping[str, sp.Symbol], shared: "Frames",
+                 collected: Collected) -> None:
         super().__init__(owner, shared, collected)
         self.p = Namespace(params, f"rig {owner!r}")
 
@@ -175,10 +184,10 @@ class Declaration(_Base):
     """
 
     def __init__(self, owner: str, coordinates: Mapping[str, sp.Function],
-                 params: Mapping[str, sp.Symbol], shared: "_Shared", collected: _Collected,
+                 params: Mapping[str, sp.Symbol], shared: "Frames", collected: Collected,
                  host: "Declaration | None" = None, hinge: tuple[str, ...] = ()) -> None:
         super().__init__(owner, shared, collected)
-        t = me.dynamicsymbols._t
+        t = TIME
         self.q = Namespace(coordinates, f"component {owner!r}")
         self.qd = Namespace({k: v.diff(t) for k, v in coordinates.items()}, f"component {owner!r}")
         self.p = Namespace(params, f"component {owner!r}")
@@ -200,7 +209,11 @@ class Declaration(_Base):
 
 
 @dataclass
-class _Shared:
+class Frames:
+    """The frames a model's declarations share: the inertial frame ``N``, the tank frame
+    ``T``, the tank origin's position in ``N`` (m), gravity (m/s^2) and the rig's input
+    signals ``(symbol, name, unit, order)``; the rig sets them, the components read them."""
+
     inertial: me.ReferenceFrame
     tank: me.ReferenceFrame
     origin_position: me.Vector

@@ -37,14 +37,38 @@ class Model:
     ----------
     components : iterable of Component, default ()
         The rig and components, in order (``+`` builds the same).
+    spec : str, optional
+        The model specification these components were built from
+        (:func:`analogs.spec.model_from_spec` gives it); :meth:`spec` returns it. A model
+        made from this one (``+``, :meth:`replace`) reads its specification from its
+        components instead.
     """
 
-    def __init__(self, components: Iterable[Component] = ()) -> None:
+    def __init__(self, components: Iterable[Component] = (), *, spec: str | None = None) -> None:
         comps = tuple(components)
         for c in comps:
             if not isinstance(c, Component):
                 raise TypeError(f"a Model holds components, got {type(c).__name__}: {c!r}")
         self._components = comps
+        self._spec = spec
+
+    def spec(self) -> str | None:
+        """The model specification (``"fixed,p1:quadratic"``, :mod:`analogs.spec`) that
+        builds this model: as given to :func:`analogs.spec.model_from_spec`, else read from
+        the components (:func:`analogs.spec.spec_of`); None when a component has no token
+        in the grammar.
+
+        Examples
+        --------
+        >>> from analogs import LateralRig, FixedMass, Pendulum, HingeDamper
+        >>> (LateralRig() + FixedMass("fixed") + Pendulum("p1") + HingeDamper("p1")).spec()
+        'fixed,p1:nospring'
+        """
+        if self._spec is not None:
+            return self._spec
+        from .spec import spec_of
+
+        return spec_of(self)
 
     # -- composition -----------------------------------------------------------------------
     def __add__(self, other: "Component | Model") -> "Model":
@@ -166,7 +190,7 @@ class Model:
 
     def explicit_values(self) -> dict[str, float]:
         """Parameter values given explicitly to component constructors (not declared defaults)."""
-        return {f"{c.prefix}.{k}": v for c in self._components for k, v in c._values.items()}
+        return {f"{c.prefix}.{k}": v for c in self._components for k, v in c.given_values.items()}
 
     def resolve(self, values: Mapping[str, float] | None = None) -> dict[str, float | None]:
         """Parameter values: ``values`` over defaults, checked against names and bounds.

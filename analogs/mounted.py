@@ -75,8 +75,8 @@ class Mounted(Component):
         self.parameters = {**component.parameters, **_MOUNT_PARAMS}
         mount = {"mount_radius": mount_radius, "mount_azimuth": mount_azimuth,
                  "mount_height": mount_height}
-        super().__init__(component.name, bounds=component._bounds,
-                         **component._values, **mount)
+        super().__init__(component.name, bounds=component.given_bounds,
+                         **component.given_values, **mount)
 
     @property
     def label(self) -> str:

@@ -144,9 +144,9 @@ def axisymmetric(model: "Model") -> "Model":
     out, problems = [], []
     for c in model.components:
         if type(c) is Pendulum:
-            out.append(SphericalPendulum(c.name, bounds=c._bounds, **c._values))
+            out.append(SphericalPendulum(c.name, bounds=c.given_bounds, **c.given_values))
         elif type(c) is HingeDamper and c.host in planar:
-            out.append(SwingDamper(c.host, bounds=c._bounds, **c._values))
+            out.append(SwingDamper(c.host, bounds=c.given_bounds, **c.given_values))
         elif isinstance(c, (Rig, FixedMass, SphericalPendulum)):
             out.append(c)
         elif isinstance(c, Attachment) and c.host in planar:

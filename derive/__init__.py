@@ -4,8 +4,10 @@ simulation, and (later) C/FMU export.
 Public API::
 
     from derive import derive, simulate, RK4, Adaptive, Sine, Sampled
+    from derive import compiled, c_compiler   # CasADi functions as C, and the compiler
 """
 
+from ._compile import c_compiler, compiled
 from ._derive import derive
 from .derived import OUTPUT_NAMES, OUTPUT_UNITS, DerivedModel, ParameterError
 from .excitation import Excitation, NoExcitation, Sampled, Sine
@@ -25,6 +27,8 @@ __all__ = [
     "Sampled",
     "Simulation",
     "Sine",
+    "c_compiler",
+    "compiled",
     "derive",
     "export_c",
     "export_fmu",

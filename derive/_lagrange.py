@@ -13,13 +13,7 @@ from sympy.core.function import AppliedUndef
 from sympy.physics import mechanics as me
 
 from analogs.component import Attachment, Rig
-from analogs.declaration import (
-    Declaration,
-    FrameDeclaration,
-    Namespace,
-    _Collected,
-    _Shared,
-)
+from analogs.declaration import TIME, Collected, Declaration, FrameDeclaration, Frames, Namespace
 from analogs.errors import InputError
 from analogs.model import Model
 
@@ -55,10 +49,10 @@ class SymbolicModel:
 def assemble(model: Model) -> SymbolicModel:
     """Derive the equations of motion and the rig outputs of ``model`` with SymPy."""
     model.validate()
-    t = me.dynamicsymbols._t
+    t = TIME
     N, T = me.ReferenceFrame("N"), me.ReferenceFrame("T")
-    shared = _Shared(N, T, me.Vector(0), me.Vector(0))
-    collected = _Collected()
+    shared = Frames(N, T, me.Vector(0), me.Vector(0))
+    collected = Collected()
     psym = {p.name: sp.Symbol(p.name, real=True) for p in model.parameters}
 
     def local_params(c):

@@ -30,7 +30,7 @@ import casadi as ca
 
 from ._trust import UntrustedCache, file_problem, folder_problem, private_folder
 
-__all__ = ["UntrustedCache", "cache_dir", "cache_key", "cache_folder", "configured_dir",
+__all__ = ["UntrustedCache", "write_atomic", "cache_dir", "cache_key", "cache_folder", "configured_dir",
            "ensure_private_dir", "file_problem", "load", "store"]
 
 _FUNCTIONS = ("rhs", "outputs", "mass_matrix", "forcing")
@@ -128,20 +128,53 @@ def load(key: str) -> tuple[dict[str, ca.Function], dict] | None:
     return fns, data["meta"]
 
 
-def store(key: str, functions: dict[str, ca.Function], meta: dict) -> Path:
-    """Write functions and metadata atomically; return the file path."""
-    folder = cache_dir()
-    serialized = {n: functions[n].serialize() for n in _FUNCTIONS}
-    data = {"meta": meta, "functions": serialized, "sha256": _checksum(meta, serialized)}
-    fd, tmp = tempfile.mkstemp(dir=folder, suffix=".tmp")
+def write_atomic(path: str | os.PathLike[str], data: bytes | str, *,
+                 mode: int | None = None) -> Path:
+    """Write ``data`` to ``path`` through a hidden temporary file in the same folder, synced
+    and then renamed: readers see the old file or the new one, never a part, and a failure
+    or an interrupt leaves the old file and no temporary one. The project's one such writer
+    (:func:`estimate.outputs.write_atomic` gives it the outputs' mode).
+
+    Parameters
+    ----------
+    path : path-like
+        The file to write; its folder must exist.
+    data : bytes or str
+        The content (``str`` is written as UTF-8).
+    mode : int, optional
+        Permission bits of the new file. Default: the temporary file's, 0600 (private, as
+        the cache's entries are).
+
+    Returns
+    -------
+    Path
+        ``path``.
+
+    Examples
+    --------
+    >>> import tempfile, pathlib
+    >>> p = write_atomic(pathlib.Path(tempfile.mkdtemp()) / "a.txt", "done")
+    >>> p.read_text()
+    'done'
+    """
+    path = Path(path)
+    fd, tmp = tempfile.mkstemp(dir=path.parent, prefix=f".{path.name}.", suffix=".tmp")
     try:
-        with os.fdopen(fd, "w") as fh:
-            json.dump(data, fh)
+        with os.fdopen(fd, "wb") as fh:
+            fh.write(data.encode() if isinstance(data, str) else data)
             fh.flush()
             os.fsync(fh.fileno())
-        path = folder / f"{key}.json"
+        if mode is not None:
+            os.chmod(tmp, mode)
         os.replace(tmp, path)
     except BaseException:
         Path(tmp).unlink(missing_ok=True)
         raise
     return path
+
+
+def store(key: str, functions: dict[str, ca.Function], meta: dict) -> Path:
+    """Write functions and metadata atomically; return the file path."""
+    serialized = {n: functions[n].serialize() for n in _FUNCTIONS}
+    data = {"meta": meta, "functions": serialized, "sha256": _checksum(meta, serialized)}
+    return write_atomic(cache_dir() / f"{key}.json", json.dumps(data))

@@ -68,7 +68,7 @@ class DerivedModel:
     from_cache : bool
         Whether the functions were loaded from the disk cache.
     _memo : dict
-        Functions built from these (maps, steps), kept with them (:meth:`memoized`).
+        Functions built from these (maps, steps), kept with them (:meth:`memo`).
     """
 
     model: Model
@@ -85,12 +85,28 @@ class DerivedModel:
     from_cache: bool = field(default=False, compare=False)
     _memo: dict = field(default_factory=dict, compare=False, repr=False)
 
-    def memoized(self, key: tuple, build: Callable[[], Any]) -> Any:
+    def memo(self, key: tuple, build: Callable[[], Any]) -> Any:
         """``build()``, called once per ``key`` and kept with the model's functions (shared
-        by every derive of the same structure in this thread)."""
+        by every derive of the same structure in this thread).
+
+        Parameters
+        ----------
+        key : tuple
+            What the built object depends on besides the model (its kind first, e.g.
+            ``("rk4_step", substeps)``).
+        build : callable
+            Makes the object (a CasADi function, a table) when ``key`` is new.
+
+        Examples
+        --------
+        >>> step = dm.memo(("rk4_step", 2), lambda: make_step(dm, 2))  # doctest: +SKIP
+        """
         if key not in self._memo:
             self._memo[key] = build()
         return self._memo[key]
+
+    #: The former name of :meth:`memo`.
+    memoized = memo
 
     def mapped(self, key: tuple, fn: ca.Function, n: int) -> ca.Function:
         """``fn.map(n)`` (``n`` parallel evaluations), kept with the model's functions
@@ -101,7 +117,7 @@ class DerivedModel:
             maps = [m for m in self._memo if m[0] == "map"]
             if len(maps) >= _MAPS_KEPT:  # many record lengths in one process: oldest out
                 del self._memo[maps[0]]
-        return self.memoized(k, lambda: fn.map(n))
+        return self.memo(k, lambda: fn.map(n))
 
     @property
     def states(self) -> tuple[str, ...]:

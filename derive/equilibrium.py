@@ -45,8 +45,8 @@ class EquilibriumEquations:
 
 def equilibrium_equations(dm: DerivedModel) -> EquilibriumEquations:
     """The equilibrium equations of ``dm`` (built once per derived model)."""
-    key = ("equilibrium",)
-    if key not in dm._memo:
+
+    def build() -> EquilibriumEquations:
         nq = len(dm.coordinates)
         q = ca.SX.sym("q", nq)
         u = ca.SX.sym("u", dm.nu)
@@ -58,12 +58,13 @@ def equilibrium_equations(dm: DerivedModel) -> EquilibriumEquations:
         rows = [q[i] if i in cyclic else f[i] for i in range(nq)]
         r = ca.vertcat(*rows) if rows else ca.SX(0, 1)
         names = ["q", "u", "p", "t"]
-        dm._memo[key] = EquilibriumEquations(
+        return EquilibriumEquations(
             ca.Function("equilibrium", [q, u, p, t], [r], names, ["r"]),
             ca.Function("equilibrium_forcing", [q, u, p, t], [f], names, ["f"]),
             ca.Function("equilibrium_jacobian", [q, u, p, t], [ca.jacobian(r, q)], names, ["J"]),
             cyclic)
-    return dm._memo[key]
+
+    return dm.memo(("equilibrium",), build)
 
 
 def relative_equilibrium(dm: DerivedModel, p: np.ndarray, time: np.ndarray, inputs: np.ndarray,

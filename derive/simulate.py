@@ -86,8 +86,8 @@ def rk4_step(dm: DerivedModel, substeps: int = 1) -> ca.Function:
     ``U`` (a column of ``nu * (2 substeps + 1)`` values) stacks the input vectors at the
     ``2 * substeps + 1`` equally spaced stage times of the interval, first time first.
     """
-    key = ("rk4_step", substeps)
-    if key not in dm._memo:
+
+    def build() -> ca.Function:
         x0 = ca.SX.sym("x", dm.nx)
         Uv = ca.SX.sym("U", dm.nu * (2 * substeps + 1))
         U = ca.reshape(Uv, dm.nu, 2 * substeps + 1)
@@ -104,9 +104,10 @@ def rk4_step(dm: DerivedModel, substeps: int = 1) -> ca.Function:
             k3 = dm.rhs(x + hs / 2 * k2, um, p, ti + hs / 2)
             k4 = dm.rhs(x + hs * k3, ub, p, ti + hs)
             x = x + hs / 6 * (k1 + 2 * k2 + 2 * k3 + k4)
-        dm._memo[key] = ca.Function("rk4_step", [x0, Uv, p, t, h], [x],
-                                    ["x", "U", "p", "t", "h"], ["x_next"])
-    return dm._memo[key]
+        return ca.Function("rk4_step", [x0, Uv, p, t, h], [x], ["x", "U", "p", "t", "h"],
+                           ["x_next"])
+
+    return dm.memo(("rk4_step", substeps), build)
 
 
 def _simulator(dm: DerivedModel, exc: Excitation, substeps: int, n: int,
@@ -119,8 +120,12 @@ def _simulator(dm: DerivedModel, exc: Excitation, substeps: int, n: int,
     the selected outputs.
     """
     key = ("sim", exc if exc.analytic else None, substeps, n, outputs, compile_)
-    if key in dm._memo:
-        return dm._memo[key]
+    return dm.memo(key, lambda: _build_simulator(dm, exc, substeps, n, outputs, compile_))
+
+
+def _build_simulator(dm: DerivedModel, exc: Excitation, substeps: int, n: int,
+                     outputs: tuple[int, ...], compile_: bool) -> ca.Function:
+    """The function :func:`_simulator` keeps with ``dm``."""
     m = 2 * substeps + 1
     x = ca.SX.sym("x", dm.nx)
     p = ca.SX.sym("p", len(dm.parameter_names))
@@ -155,7 +160,6 @@ def _simulator(dm: DerivedModel, exc: Excitation, substeps: int, n: int,
         from ._compile import compiled
 
         fn = compiled(fn)
-    dm._memo[key] = fn
     return fn
 
 

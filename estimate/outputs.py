@@ -39,7 +39,8 @@ from analogs.errors import InputError
 from .inputs import file_kind
 from .interrupts import deferred, temporary
 
-__all__ = ["NON_FINITE_KEY", "OutputError", "Outputs", "committed", "json_text", "output_mode"]
+__all__ = ["NON_FINITE_KEY", "OutputError", "Outputs", "committed", "json_text", "output_mode",
+           "write_atomic"]
 
 #: Key of the note that lists the values written as ``null`` because they were not finite.
 NON_FINITE_KEY = "non_finite"
@@ -91,6 +92,29 @@ def output_mode(*, folder: bool = False) -> int:
     >>> _ = os.umask(old)
     """
     return (0o777 if folder else 0o666) & ~_umask()
+
+
+def write_atomic(path: str | os.PathLike[str], data: bytes | str) -> Path:
+    """Write one file outside an :class:`Outputs` transaction (a store entry, a manifest):
+    through a temporary file and a rename (:func:`derive.cache.write_atomic`), readers see
+    the old file or the new one, never a part; the file gets the mode of any other output
+    (:func:`output_mode`: 0644 under umask 022), not the temporary file's 0600.
+
+    Parameters
+    ----------
+    path : path-like
+        The file to write; its folder must exist.
+    data : bytes or str
+        The content (``str`` as UTF-8).
+
+    Returns
+    -------
+    Path
+        ``path``.
+    """
+    from derive.cache import write_atomic as write
+
+    return write(path, data, mode=output_mode())
 
 
 def _remove(path: Path) -> None:

@@ -37,7 +37,7 @@ _ELSEWHERE = {
     "estimate.Diagnosis": ("baseline baseline_evidence candidate_fits final final_evidence findings notes "
                            "rounds seconds verdict"),
     "estimate.Finding": "added bic_change cause evidence gain rms_after",
-    "estimate.FitProblem": "experiments force_cutoff_hz model notes",
+    "estimate.FitProblem": "experiments model notes",
     "estimate.FitProblem.case_values": "model_only",
     "estimate.FitProblem.report_scale": "channel",
     "estimate.FitProblem.with_displacement_noise": "levels",

@@ -76,7 +76,7 @@ def solve(tank: Tank, depth: float, *, degree: int = 8, layers: int = 8, ratio: 
     lv, ld = _lagrange(ref, xq)
 
     t_br = _graded(0.0, 1.0, layers, ratio, 2)
-    slices = [sl for sl in tank._slices() if sl.z0 < depth]
+    slices = [sl for sl in tank.wall_slices() if sl.z0 < depth]
     s_elems = []  # (slice, sa, sb)
     for k, sl in enumerate(slices):
         s0, s1 = sl.param_range()

@@ -140,7 +140,9 @@ class Tank:
                    for p in self._pieces())
 
     # -- slicing ------------------------------------------------------------------------
-    def _slices(self) -> list[_Slice]:
+    def wall_slices(self) -> list[_Slice]:
+        """The wall cut into pieces of rising height (m), bottom first: each with its
+        heights ``z0 < z1`` and its parametrisation (the finite elements mesh these)."""
         out = []
         for p in self._pieces():
             if p[0] == "line":
@@ -154,7 +156,7 @@ class Tank:
 
     def wall_radius(self, z: float) -> float:
         """Inside radius of the wall in m at height ``z`` (m) above the tank bottom."""
-        for sl in self._slices():
+        for sl in self.wall_slices():
             if sl.z0 <= z <= sl.z1:
                 return float(sl.point(np.array(sl.param_at(z)))[0])
         raise ValueError(f"`z` must lie in [0, {self.height}] m; got {z!r}.")
@@ -171,7 +173,7 @@ class Tank:
         xs, ws = np.polynomial.legendre.leggauss(ns)
         t, wt = 0.5 * (xt + 1.0), 0.5 * wt
         rs, zs, ww = [], [], []
-        for sl in self._slices():
+        for sl in self.wall_slices():
             if sl.z0 >= depth:
                 break
             s0, s1 = sl.param_range()

@@ -29,7 +29,6 @@ import hashlib
 import math
 import os
 from collections.abc import Mapping
-from dataclasses import dataclass
 from pathlib import Path
 from typing import Any
 
@@ -38,8 +37,9 @@ from analogs.errors import InputError
 from ..data.case import SHAPE_KEYS
 from ..data.models import BASELINE
 from ..data.reader import MAX_CASE_FILE_BYTES
-from ..fitting.problem import INPUT_MODES
+from ..fitting.strategies import DEFAULT_INPUT, INPUT_MODES
 from ..inputs import file_kind, load_toml, open_input
+from .catalogue import Campaign, Group, Record, Setup
 
 __all__ = ["CAMPAIGN_FILE", "Campaign", "Group", "Record", "Setup", "discover"]
 
@@ -47,134 +47,6 @@ __all__ = ["CAMPAIGN_FILE", "Campaign", "Group", "Record", "Setup", "discover"]
 CAMPAIGN_FILE = "campaign.toml"
 _CAMPAIGN_KEYS = {"title", "note", "model", "input"}
 _GROUP_KEYS = {"records", "model"}
-
-
-@dataclass(frozen=True)
-class Setup:
-    """What makes records one group: ``rig`` kind, ``[tank]`` (``shape``, ``radius`` in m -
-    NaN for a rectangular tank -, ``fill_fraction``, ``diaphragm``, the shape's other
-    ``sizes`` in m) and ``[liquid]`` (``density`` in kg/m^3, kinematic ``viscosity`` in
-    m^2/s), and ``[rig] gravity`` (``gravity``, m/s^2) for the tank prediction."""
-
-    rig: str
-    shape: str
-    radius: float
-    fill_fraction: float
-    diaphragm: bool
-    density: float
-    viscosity: float
-    gravity: float
-    #: ``[tank]`` sizes besides the radius (``(("length", 0.3),)`` for a cylinder), m.
-    sizes: tuple[tuple[str, float], ...] = ()
-
-    @property
-    def series(self) -> tuple:
-        """The setup without the fill: records of one series lie on one prediction curve."""
-        return (self.rig, self.shape, self.radius, self.sizes, self.diaphragm, self.density,
-                self.viscosity, self.gravity)
-
-    def geometry(self):
-        """The tank as an :mod:`analogs.tank` geometry (see
-        :meth:`estimate.data.case.Tank.geometry`)."""
-        from ..data.case import Tank
-
-        radius = None if math.isnan(self.radius) else self.radius
-        return Tank(self.shape, radius, self.fill_fraction, self.diaphragm,
-                    **dict(self.sizes)).geometry()
-
-    @property
-    def size_name(self) -> str:
-        """``R0.1016`` (axisymmetric), ``0.4x0.2x0.3`` (rectangular), plus other sizes."""
-        head = [] if math.isnan(self.radius) else [f"R{self.radius:g}"]
-        if self.shape == "rectangular":
-            return "x".join(f"{v:g}" for _, v in self.sizes)
-        return "-".join(head + [f"{k}{v:g}" for k, v in self.sizes])
-
-
-@dataclass(frozen=True)
-class Record:
-    """One case file of the campaign.
-
-    Attributes
-    ----------
-    id : str
-        ``[test] id`` (the file name without ``.toml`` when the file cannot be read).
-    path : pathlib.Path
-        The case file, resolved.
-    relpath : str
-        The case file relative to the campaign folder (POSIX separators).
-    toml_sha256, data_sha256 : str or None
-        SHA-256 of the case file's and of its data file's bytes (None: not readable).
-    setup : Setup or None
-        The grouping keys, None when the file does not give them all (the record is then
-        in no group; loading it reports what is wrong).
-    data_bytes : int
-        Size of the data file (0: not readable), the measure of a task's work for the
-        campaign's time left.
-    """
-
-    id: str
-    path: Path
-    relpath: str
-    toml_sha256: str | None
-    data_sha256: str | None
-    setup: Setup | None
-    data_bytes: int = 0
-
-
-@dataclass(frozen=True)
-class Group:
-    """Records fitted together (shared physical parameters) with ``model``: the group's
-    ``name`` and its ``records`` (ids)."""
-
-    name: str
-    records: tuple[str, ...]
-    model: str
-
-
-@dataclass(frozen=True)
-class Campaign:
-    """A discovered campaign (see :func:`discover`).
-
-    Attributes
-    ----------
-    source : str
-        The folder or glob given.
-    root : Path
-        The campaign folder (of ``campaign.toml``, and of the records' relative paths).
-    title, note : str
-        ``[campaign] title`` and ``note`` (empty when not given).
-    model, input : str
-        The campaign's model specification and carriage input mode.
-    records : tuple of Record
-        Every case file found, by path.
-    groups : tuple of Group
-        The groups fitted together.
-    """
-
-    source: str
-    root: Path
-    title: str
-    note: str
-    model: str
-    input: str
-    records: tuple[Record, ...]
-    groups: tuple[Group, ...]
-    #: TOML files that are not case files (no ``[test]`` table).
-    skipped: tuple[str, ...] = ()
-
-    def record(self, record_id: str) -> Record:
-        """The record whose ``[test] id`` is ``record_id``."""
-        return next(r for r in self.records if r.id == record_id)
-
-    def group_of(self, record_id: str) -> Group | None:
-        """The group of the record ``record_id``, or None (in no group)."""
-        return next((g for g in self.groups if record_id in g.records), None)
-
-    def model_of(self, record_id: str) -> str:
-        """The model of the record ``record_id``: its group's, else the campaign's."""
-        group = self.group_of(record_id)
-        return group.model if group is not None else self.model
 
 
 def _sha256(path: Path) -> str | None:
@@ -331,7 +203,7 @@ def _settings(path: Path, records: tuple[Record, ...]) -> tuple[dict[str, Any], 
         if not isinstance(settings[key], str):
             problems.append(f"{fname}: [campaign] {key}: expected a string, found "
                             f"{settings[key]!r}")
-    if settings.get("input", "estimated") not in INPUT_MODES:
+    if settings.get("input", DEFAULT_INPUT.name) not in INPUT_MODES:
         problems.append(f"{fname}: [campaign] input: expected one of "
                         f"{', '.join(INPUT_MODES)}, found {settings['input']!r}")
     if isinstance(settings.get("model"), str):
@@ -367,18 +239,15 @@ def _nearest(key: str, known: set[str], *, table: bool = False) -> str:
 def _spec_problems(spec: str, where: str, records) -> list[str]:
     """Why the model specification ``spec`` (from ``where``) cannot be built for the rigs of
     ``records`` (checked at discovery, so that the key that gave it is named)."""
-    from types import SimpleNamespace
-
-    from ..data.models import model_from_spec
+    from analogs import LateralRig, SpinningRig
+    from analogs.spec import model_from_spec
 
     rigs = sorted({r.setup.rig for r in records if r.setup is not None} & {"lateral", "spinning"})
-    spin = SimpleNamespace(gravity_on=True, tank_axis="spin", motion="constant")
     for rig in rigs or ["lateral"]:
-        stub = SimpleNamespace(test=SimpleNamespace(rig=rig, excitation="spin" if rig == "spinning"
-                                                    else "measured"),
-                               rig=SimpleNamespace(spin=spin), path=where)
+        on = (SpinningRig(gravity=True, tank_axis="spin", motion="constant") if rig == "spinning"
+              else LateralRig(excitation="measured"))
         try:
-            model_from_spec(spec, stub, option=where)
+            model_from_spec(spec, on, option=where)
         except InputError as err:
             return [str(err)]
     return []
@@ -439,5 +308,5 @@ def discover(source: str, *, model: str | None = None) -> Campaign:
         groups = tuple(Group(g.name, g.records, model) for g in groups)
     return Campaign(source=str(source), root=root, title=settings.get("title", ""),
                     note=settings.get("note", ""), model=spec,
-                    input=settings.get("input", "estimated"), records=records, groups=groups,
+                    input=settings.get("input", DEFAULT_INPUT.name), records=records, groups=groups,
                     skipped=skipped)

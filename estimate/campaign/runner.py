@@ -109,7 +109,7 @@ class _Runner:
             ) -> dict[str, dict[str, Any]]:
         """Outcomes of ``(kind, label, record ids, model)`` tasks by key: from the store,
         from a failed load, or computed now."""
-        keys = [self._key(*w) for w in wanted]
+        keys = [self.key_of(*w) for w in wanted]
         new = {k: w for k, w in zip(keys, wanted) if k not in self.outcomes}
         self.work.update({k: self.work_of(w[0], w[2]) for k, w in new.items()})
         self.progress.expect(len(new), sum(self.work[k] for k in new))
@@ -137,7 +137,9 @@ class _Runner:
         self._execute(sorted(tasks.values(), key=self._cost))
         return {key: self.outcomes[key] for key in keys}
 
-    def _key(self, kind: str, label: str, ids: tuple[str, ...], model: str | None) -> str:
+    def key_of(self, kind: str, label: str, ids: tuple[str, ...], model: str | None) -> str:
+        """The store key of a task: its kind, its records' files, the model spec and,
+        for fits, the campaign's options (``label`` only names it)."""
         return task_key(kind, self.files(ids), model, self.options if kind == "fit" else {})
 
     @staticmethod
@@ -210,8 +212,8 @@ def run_campaign(campaign: Campaign, out: str | Path, *, executor: Executor | No
         if diagnose:
             stage += [("diagnosis", f"diagnosis {i}", (i,), None) for i in ids]
         done = runner.run(stage)
-        records = {w[2][0]: done[runner._key(*w)] for w in stage if w[0] == "fit"}
-        diagnoses = {w[2][0]: done[runner._key(*w)] for w in stage if w[0] == "diagnosis"}
+        records = {w[2][0]: done[runner.key_of(*w)] for w in stage if w[0] == "fit"}
+        diagnoses = {w[2][0]: done[runner.key_of(*w)] for w in stage if w[0] == "diagnosis"}
         outliers, threshold = find_outliers([(g.name, g.records) for g in campaign.groups],
                                             records)
         flagged = {o.record for o in outliers}
@@ -231,7 +233,7 @@ def run_campaign(campaign: Campaign, out: str | Path, *, executor: Executor | No
     group_out = {}
     for g in campaign.groups:
         wanted = next((w for name, w in groups if name == g.name), None)
-        outcome = dict(fitted[runner._key(*wanted)]) if wanted else {
+        outcome = dict(fitted[runner.key_of(*wanted)]) if wanted else {
             "status": "failed", "error": "no record of the group can be fitted",
             "failure": "inputs"}
         outcome["members"] = list(wanted[2]) if wanted else []

@@ -20,7 +20,6 @@ from __future__ import annotations
 import hashlib
 import json
 import os
-import tempfile
 import warnings
 from collections.abc import Callable, Mapping, Sequence
 from pathlib import Path
@@ -29,6 +28,7 @@ from typing import Any
 from analogs.errors import InputError
 
 from ..inputs import load_json
+from ..outputs import write_atomic
 from ..version import package_version
 
 __all__ = ["MAX_ENTRY_BYTES", "STORE_SCHEMA", "Store", "outcome_checksum", "package_version",
@@ -65,28 +65,6 @@ def task_key(task: str, files: Sequence[tuple[str | None, str | None]], model: s
            "files": [list(f) for f in files], "model": model, "options": dict(options)}
     text = json.dumps(doc, sort_keys=True, separators=(",", ":"))
     return hashlib.sha256(text.encode()).hexdigest()
-
-
-def write_atomic(path: str | os.PathLike[str], data: bytes) -> Path:
-    """Write ``data`` to ``path`` through a hidden temporary file in the same folder and a
-    rename: readers see the old file or the new one, never a part. The file gets the mode
-    of any other output (:func:`estimate.outputs.output_mode`: 0644 under umask 022), not
-    the temporary file's 0600."""
-    from ..outputs import output_mode
-
-    path = Path(path)
-    fd, tmp = tempfile.mkstemp(dir=path.parent, prefix=f".{path.name}.", suffix=".tmp")
-    try:
-        with os.fdopen(fd, "wb") as fh:
-            fh.write(data)
-            fh.flush()
-            os.fsync(fh.fileno())
-        os.chmod(tmp, output_mode())
-        os.replace(tmp, path)
-    except BaseException:
-        Path(tmp).unlink(missing_ok=True)
-        raise
-    return path
 
 
 class Store:

@@ -16,6 +16,7 @@ import numpy as np
 from analogs.errors import InputError
 
 from ..data.case import Case
+from ..fitting.strategies import DEFAULT_INPUT
 
 __all__ = ["FAILURE_CAUSES", "Task", "check_outcome", "drive_amplitude", "found_quantities",
            "run_task"]
@@ -55,7 +56,7 @@ class Task:
     label: str
     cases: tuple[Case, ...] = field(repr=False)
     model: str | None
-    input: str = "estimated"
+    input: str = DEFAULT_INPUT.name
 
 
 def drive_amplitude(case: Case) -> float:

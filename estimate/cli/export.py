@@ -11,7 +11,6 @@ import argparse
 import math
 import sys
 from pathlib import Path
-from types import SimpleNamespace
 
 from analogs import Model
 from analogs.errors import InputError
@@ -90,11 +89,10 @@ def export_model(spec: str, values: dict[str, float], *, interface: str = "rig",
     InputError
         For an unknown interface, or a vehicle analog that cannot be made 3-D.
     """
-    from ..data.models import model_from_spec
+    from analogs import LateralRig
+    from analogs.spec import model_from_spec
 
-    lateral = SimpleNamespace(test=SimpleNamespace(rig="lateral", excitation="measured"),
-                              path="(export)")
-    model = model_from_spec(spec, lateral)
+    model = model_from_spec(spec, LateralRig(excitation="measured"))
     if interface == "vehicle":
         analog = model.without(model.rig.name)
         if not planar:

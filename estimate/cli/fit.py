@@ -98,7 +98,9 @@ def run(args: argparse.Namespace) -> int:
         print(f"warning: {w}", file=sys.stderr)
     spec = BASELINE if args.model is None else args.model
     model = model_from_spec(spec, cases[0])
-    mode = args.input or ("filtered" if args.cost == "abs" else "estimated")
+    # the abs cost cannot tell the carriage's sign: it takes the filtered input; else the
+    # input mode's default (estimate.fitting.strategies.DEFAULT_INPUT)
+    mode = args.input or ("filtered" if args.cost == "abs" else None)
     measurement = (() if args.channel_offsets == "none"
                    else (ChannelOffsets(drift=args.channel_offsets == "drift"),))
     problem = FitProblem.build(cases, model, input=mode, measurement=measurement)

@@ -86,7 +86,7 @@ def _measured(exp, res):
     """The case's measurement of the plotted output, low-passed as the fit saw it (the
     10 Hz force filter), or None when the case does not measure it."""
     from ..data.signals import lowpass
-    from ..fitting.problem import FILTERED_FORCE_CUTOFF_HZ
+    from ..fitting.strategies import FILTERED_FORCE_CUTOFF_HZ
 
     raw = exp.case.channels.get(next(iter(res.outputs)))
     if raw is None:

@@ -57,6 +57,11 @@ class Asked(Mapping):
     def __repr__(self) -> str:
         return repr(self._data)
 
+    @property
+    def data(self) -> Mapping[str, Any]:
+        """The table as read (not a view: looking keys up in it is not recorded)."""
+        return self._data
+
     def unknown(self) -> list[tuple[tuple[str, ...], str, list[str]]]:
         """``(table path, key, known keys of that table)`` of every key of the document not
         looked up, in document order; tables are entered only where the reader did."""
@@ -86,7 +91,7 @@ def unknown_keys(doc: Asked, filename: str, *, ignored: bool = True) -> list[str
     the key and the nearest known name (:func:`difflib.get_close_matches`); ``ignored``:
     say that it is ignored (a warning) rather than refused."""
     lines = []
-    raw = doc._data
+    raw = doc.data
     for path, key, known in doc.unknown():
         table: Any = raw
         for part in path:

@@ -3,42 +3,20 @@ rig values a case file fixes."""
 
 from __future__ import annotations
 
-from analogs import (
-    DiaphragmSpring,
-    FixedMass,
-    HingeDamper,
-    HingeSpring,
-    LateralRig,
-    Model,
-    Pendulum,
-    QuadraticDamper,
-    Rotor,
-    SphericalPendulum,
-    SpinningRig,
-)
+from analogs import LateralRig, Model, SpinningRig
 from analogs.component import Rig
 from analogs.errors import InputError
-from analogs.tank.prediction import MAX_MODES
+from analogs.spec import ROTOR_AXIS, spec_of
+from analogs.spec import model_from_spec as spec_model
 
 from .case import Case
 
 __all__ = ["BASELINE", "ROTOR_AXIS", "model_for_case", "model_from_spec", "model_spec", "rig_for",
            "rig_values"]
 
-#: Tank axis of rotor analogs on the spinning rig: ``T.y``, the tangential direction (the
-#: way the tank origin moves), about which the nutation drives a rotor (the spin-axis
-#: component of the tank's angular acceleration is zero, see :class:`analogs.SpinningRig`).
-ROTOR_AXIS = "y"
-
 #: The default model of ``slosh simulate`` and ``slosh fit``: fixed mass + first-mode
 #: pendulum with hinge spring and linear hinge damper.
 BASELINE = "fixed,p1"
-
-_MODIFIERS = {
-    "nospring": "pendulum without hinge spring",
-    "quadratic": "adds a QuadraticDamper",
-    "diaphragm": "adds a DiaphragmSpring",
-}
 
 
 def rig_for(case: Case) -> Rig:
@@ -63,18 +41,18 @@ def model_for_case(model: Model, case: Case) -> Model:
     rig = model.rig
     spin = case.rig.spin
     if isinstance(rig, SpinningRig) and spin is not None and rig.motion != spin.motion:
-        keep = {k: v for k, v in rig._values.items() if k in ("dry_mass", "radius", "height",
+        keep = {k: v for k, v in rig.given_values.items() if k in ("dry_mass", "radius", "height",
                                                                 "gravity")}
         return model.replace(SpinningRig(gravity=rig.with_gravity, tank_axis=rig.tank_axis,
                                          motion=spin.motion, name=rig.name,
-                                         bounds={k: v for k, v in rig._bounds.items() if k in keep},
+                                         bounds={k: v for k, v in rig.given_bounds.items() if k in keep},
                                          **keep))
     if isinstance(rig, LateralRig) and case.test.rig == "lateral" \
             and rig.excitation != case.test.excitation:
         shared = {"dry_mass", "gravity"}  # what both excitations of the rig have
         swapped = LateralRig(excitation=case.test.excitation, name=rig.name,
-                             bounds={k: v for k, v in rig._bounds.items() if k in shared},
-                             **{k: v for k, v in rig._values.items() if k in shared})
+                             bounds={k: v for k, v in rig.given_bounds.items() if k in shared},
+                             **{k: v for k, v in rig.given_values.items() if k in shared})
         return model.replace(swapped)
     return model
 
@@ -103,24 +81,10 @@ def rig_values(case: Case) -> dict[str, float]:
     return out
 
 
-def _tokens_text(spinning: bool) -> str:
-    rotor = "; `rotor` or `rN` (rotor, spinning rig)" if spinning else ""
-    return (f"valid tokens: `fixed`; `p1` to `p{MAX_MODES}` (pendulum of slosh mode N, the "
-            "modes the tank prediction gives), optionally with modifiers `:nospring`, "
-            f"`:quadratic`, `:diaphragm`{rotor}; e.g. `fixed,p1,p2:quadratic`")
-
-
-def _number_of(name: str, letter: str) -> int | None:
-    """N of ``pN``/``rN`` written without leading zeros, else None."""
-    digits = name[1:]
-    if name[:1] != letter or not digits.isascii() or not digits.isdigit():
-        return None
-    return int(digits) if digits == str(int(digits)) else None
-
-
 def model_from_spec(spec: str, case: Case, *, option: str = "--model") -> Model:
     """Build a model from a comma-separated specification ``spec`` such as
-    ``"fixed,p1,p2"``, on the rig of ``case``.
+    ``"fixed,p1,p2"``, on the rig of ``case`` (:func:`rig_for`); the grammar is
+    :mod:`analogs.spec`'s (:func:`analogs.spec.model_from_spec`).
 
     Tokens: ``fixed`` (FixedMass); ``pN`` with N from 1 to ``MAX_MODES`` (6: the modes the
     tank prediction gives initial values for) (Pendulum with HingeSpring and HingeDamper;
@@ -135,65 +99,13 @@ def model_from_spec(spec: str, case: Case, *, option: str = "--model") -> Model:
     --------
     >>> model = model_from_spec("fixed,p1:nospring,r1", spinning_case)   # doctest: +SKIP
     """
-    model: Model = Model((rig_for(case),))
-    spinning = case.test.rig == "spinning"
-    problems = []
-    tokens = [tok.strip() for tok in spec.replace("+", ",").split(",") if tok.strip()]
-    if not tokens:
-        problems.append("empty model specification")
-    names = [tok.split(":")[0] for tok in tokens]
-    for name in sorted({n for n in names if names.count(n) > 1}):
-        problems.append(f"`{name}` is given {names.count(name)} times; give each component once")
-    for tok in tokens:
-        name, *mods = tok.split(":")
-        unknown = [m for m in mods if m not in _MODIFIERS]
-        if unknown:
-            problems.append(f"`{tok}`: unknown modifier {', '.join(map(repr, unknown))}; known: "
-                            + ", ".join(f"{k} ({v})" for k, v in _MODIFIERS.items()))
-            continue
-        pendulum, rotor = _number_of(name, "p"), _number_of(name, "r")
-        if name == "fixed":
-            if mods:
-                problems.append(f"`{tok}`: `fixed` takes no modifiers")
-            model = model + FixedMass("fixed")
-        elif name == "rotor" or rotor is not None:
-            if not spinning:
-                problems.append(f"`{tok}`: a rotor needs a rig that rotates (`rig = \"spinning\"`)")
-            elif mods:
-                problems.append(f"`{tok}`: a rotor takes no modifiers")
-            elif rotor == 0:
-                problems.append(f"`{tok}`: rotors are numbered from r1")
-            else:
-                model = model + Rotor(name, axis=ROTOR_AXIS)
-        elif pendulum is not None and 1 <= pendulum <= MAX_MODES:
-            pend = SphericalPendulum(name) if spinning else Pendulum(name)
-            model = model + pend + HingeDamper(name)
-            if "nospring" not in mods:
-                model = model + HingeSpring(name)
-            if "quadratic" in mods:
-                model = model + QuadraticDamper(name)
-            if "diaphragm" in mods:
-                model = model + DiaphragmSpring(name)
-        elif pendulum is not None:
-            problems.append(f"`{tok}`: pendulums are numbered by slosh mode, from p1 to "
-                            f"p{MAX_MODES}")
-        else:
-            problems.append(f"`{tok}`: unknown component")
-    if problems:
-        raise InputError(f"{option} {spec!r}: " + "; ".join(problems) + "; "
-                         + _tokens_text(spinning))
-    return model.validate()
-
-
-#: Attachments a ``pN`` token may carry, by modifier (None: always there).
-_ATTACHMENTS = {HingeDamper: None, HingeSpring: "spring", QuadraticDamper: "quadratic",
-                DiaphragmSpring: "diaphragm"}
+    return spec_model(spec, rig_for(case), option=option)
 
 
 def model_spec(model: Model) -> str | None:
     """The specification :func:`model_from_spec` builds ``model`` from (``"fixed,p1:nospring"``),
-    or None when the model holds a component the grammar has no token for (a diagnosis's
-    library term, a rig friction, a pendulum under another name).
+    or None when the model holds a component the grammar has no token for
+    (:func:`analogs.spec.spec_of`; :meth:`analogs.Model.spec` gives a specification as given).
 
     Examples
     --------
@@ -202,37 +114,4 @@ def model_spec(model: Model) -> str | None:
     ...            + QuadraticDamper("p1"))
     'fixed,p1:nospring:quadratic'
     """
-    from analogs.component import Attachment
-
-    attached: dict[str, set[str | None]] = {}
-    tokens: list[str] = []
-    for c in model.components:
-        if isinstance(c, Rig):
-            continue
-        if isinstance(c, Attachment):
-            kind = _ATTACHMENTS.get(type(c), "?")
-            if kind == "?":
-                return None
-            attached.setdefault(c.name, set()).add(kind)
-        elif type(c) is FixedMass and c.name == "fixed":
-            tokens.append("fixed")
-        elif type(c) in (Pendulum, SphericalPendulum) and _number_of(c.name, "p"):
-            tokens.append(c.name)
-        elif type(c) is Rotor and (c.name == "rotor" or _number_of(c.name, "r")):
-            tokens.append(c.name)
-        else:
-            return None
-    out = []
-    for tok in tokens:
-        kinds = attached.pop(tok, set())
-        if not tok.startswith("p"):
-            if kinds:
-                return None
-            out.append(tok)
-            continue
-        if None not in kinds:  # every pendulum of the grammar has its hinge damper
-            return None
-        mods = [] if "spring" in kinds else ["nospring"]
-        mods += [m for m in ("quadratic", "diaphragm") if m in kinds]
-        out.append(":".join([tok, *mods]))
-    return ",".join(out) if out and not attached else None
+    return spec_of(model)

@@ -153,7 +153,7 @@ class LateralDrive:
             xdd = ca.gradient(xd, t)
             fn = ca.Function(f"drive_{cls.family}", [t, scale, v, lim, T],
                              [ca.vertcat(x, xd, xdd)])
-            from derive._compile import c_compiler, compiled
+            from derive import c_compiler, compiled
 
             _FUNCTIONS[cls.family] = compiled(fn) if c_compiler() else fn
         return _FUNCTIONS[cls.family]

@@ -98,7 +98,7 @@ class Sensitivities:
         X0 = ca.MX.sym("x0", nx)
         X = ca.horzcat(X0, plain.mapaccum(n)(X0, UU, P0, TH, T[:, :n], H))
         self._states = ca.Function("design_states", [X0, UU, P0, TH, T, H], [X])
-        from derive._compile import c_compiler, compiled
+        from derive import c_compiler, compiled
 
         if c_compiler():  # the whole record in C: no per-step call overhead (cached on disk)
             self._run, self._states = compiled(self._run), compiled(self._states)
@@ -159,9 +159,9 @@ def sensitivities(dm: DerivedModel, names: Sequence[str], channels: Sequence[str
                   n: int) -> Sensitivities:
     """The :class:`Sensitivities` of ``dm`` for ``names``, ``channels`` and ``n`` intervals,
     built once per derived structure (kept with its functions,
-    :meth:`derive.DerivedModel.memoized`)."""
+    :meth:`derive.DerivedModel.memo`)."""
     key = ("design_sensitivities", tuple(names), tuple(channels), n)
-    return dm.memoized(key, lambda: Sensitivities(dm, tuple(names), tuple(channels), n))
+    return dm.memo(key, lambda: Sensitivities(dm, tuple(names), tuple(channels), n))
 
 
 def swing_angles(dm: DerivedModel, states: np.ndarray) -> dict[str, np.ndarray]:

@@ -6,7 +6,16 @@ from .nlp import Hessian, fit
 from .problem import FitProblem
 from .profile import profile_interval
 from .result import FitResult
+from .strategies import (
+    AbsCost,
+    EstimatedInput,
+    FilteredInput,
+    FirstStageStart,
+    PredictionStart,
+    SquaredCost,
+)
 from .transcription import Collocation, MultipleShooting
 
-__all__ = ["ChannelOffsets", "Collocation", "FitProblem", "FitResult", "Hessian", "MultipleShooting", "fit",
-           "profile_interval"]
+__all__ = ["AbsCost", "ChannelOffsets", "Collocation", "EstimatedInput", "FilteredInput",
+           "FirstStageStart", "FitProblem", "FitResult", "Hessian", "MultipleShooting",
+           "PredictionStart", "SquaredCost", "fit", "profile_interval"]

@@ -15,8 +15,6 @@ from __future__ import annotations
 import functools
 import hashlib
 import json
-import os
-import tempfile
 from dataclasses import dataclass
 from pathlib import Path
 from typing import Any
@@ -86,13 +84,9 @@ class CachedSolver:
 
 
 def _write(path: Path, data: dict) -> None:
+    from derive.cache import write_atomic
+
     try:
-        fd, tmp = tempfile.mkstemp(dir=path.parent, suffix=".tmp")
+        write_atomic(path, json.dumps(data))
     except OSError:
-        return  # a cache that cannot be written only costs time
-    try:
-        with os.fdopen(fd, "w") as fh:
-            json.dump(data, fh)
-        os.replace(tmp, path)
-    except OSError:
-        Path(tmp).unlink(missing_ok=True)
+        pass  # a cache that cannot be written only costs time

@@ -3,7 +3,9 @@
 from __future__ import annotations
 
 import math
+import weakref
 from collections.abc import Iterable, Mapping
+from typing import Any
 
 from analogs import Model
 from analogs.errors import InputError
@@ -11,7 +13,7 @@ from analogs.errors import InputError
 from ..data.case import Case
 
 __all__ = ["predicted_values", "predicted_sources", "source_notes", "prediction_conflicts",
-           "length_bounds", "nominal_scale", "tank_prediction", "LENGTH_BAND",
+           "length_bounds", "nominal_scale", "tank_prediction", "case_prediction", "LENGTH_BAND",
            "PREDICTION_FACTOR"]
 
 #: Pendulum lengths are kept within +/-20 % of the prediction, as classical slosh-test fits do.
@@ -44,6 +46,35 @@ def tank_prediction(tank, fill: float, *, density: float, viscosity: float, grav
                    diaphragm=diaphragm)
 
 
+#: The tank predictions of live cases: ``id(case) -> (weak reference, {modes: prediction})``
+#: (a case holds arrays, so it is no dictionary key itself).
+_PREDICTIONS: dict[int, tuple[weakref.ref, dict[int, Any]]] = {}
+
+
+def case_prediction(case: Case, modes: int):
+    """The tank modal analysis of ``case`` with ``modes`` modes (:func:`tank_prediction` of
+    its ``[tank]``, ``[liquid]`` and gravity), computed once per case and number of modes:
+    a fit asks for it when it loads (:func:`prediction_conflicts`), for the first stage's
+    frequency and for the initial values. A failure is not kept (it is raised each time).
+
+    Parameters
+    ----------
+    case : Case
+        A loaded case (never changed: a case is immutable).
+    modes : int
+        Number of slosh modes.
+    """
+    key = id(case)
+    entry = _PREDICTIONS.get(key)
+    if entry is None or entry[0]() is not case:
+        entry = (weakref.ref(case, lambda _: _PREDICTIONS.pop(key, None)), {})
+        _PREDICTIONS[key] = entry
+    kept = entry[1]
+    if modes not in kept:
+        kept[modes] = _tank_prediction(case, modes)
+    return kept[modes]
+
+
 def _tank_prediction(case: Case, modes: int):
     return tank_prediction(case.tank.geometry(), case.tank.fill_fraction,
                            density=case.liquid.density,
@@ -58,7 +89,7 @@ def prediction_conflicts(case: Case, *, factor: float = PREDICTION_FACTOR) -> li
     pr = case.prediction
     if pr is None:
         return []
-    pred = _tank_prediction(case, 1)
+    pred = case_prediction(case, 1)
     pairs = (("pendulum_mass", pr.pendulum_mass, pred.modes[0].mass, "kg"),
              ("pendulum_length", pr.pendulum_length, pred.modes[0].length, "m"),
              ("fixed_mass", pr.fixed_mass, pred.fixed_mass.mass, "kg"))
@@ -117,7 +148,7 @@ def predicted_sources(case: Case, model: Model, needed: Iterable[str] | None = N
     failure = None
     if analysis_needed:
         try:
-            analysis = _tank_prediction(case, max(n_modes, 1))
+            analysis = case_prediction(case, max(n_modes, 1))
         except (InputError, ValueError, ArithmeticError) as err:
             analysis, failure = None, f"the tank modal analysis failed: {err}"
         if analysis is not None:

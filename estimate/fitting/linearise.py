@@ -14,8 +14,8 @@ import scipy.sparse as sps
 import scipy.sparse.linalg as spla
 
 from ._sparse import scipy_csc
+from .assembly import assemble_nlp
 from .covariance import ReducedKKT
-from .nlp import _setup
 from .problem import FitProblem
 from .result import FitResult
 from .transcription import MultipleShooting, Transcription
@@ -104,7 +104,7 @@ def linearise(problem: FitProblem, *, warm_start: FitResult | None = None,
     gain, predicted without solving (one sparse factorisation)."""
     est = problem.estimated
     kinds = [initial_state or e.initial_state_kind for e in problem.experiments]
-    nlp, _ = _setup(problem, transcription, "squared", kinds, True, False, warm_start)
+    nlp, _ = assemble_nlp(problem, transcription, "squared", kinds, True, False, warm_start)
     w0 = nlp.w0
     e, Je = ca.Function("e", [nlp.w], [nlp.e, nlp.jac_r])(w0)
     e, Je = np.asarray(e).ravel(), scipy_csc(Je)

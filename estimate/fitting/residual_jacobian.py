@@ -15,6 +15,7 @@ import casadi as ca
 import numpy as np
 
 from derive import OUTPUT_NAMES, DerivedModel
+from derive import compiled as compile_fn
 
 from ._sparse import affine_parameters, scatter
 
@@ -27,7 +28,8 @@ def output_jacobian(dm: DerivedModel, channels: tuple[str, ...], ntheta: int,
     outputs ``y`` (one row per channel) with ``p = p0 + S theta``. Built (and compiled)
     once per model, channels and number of estimates."""
     key = ("output_jacobian", channels, ntheta, compiled)
-    if key not in dm._memo:
+
+    def build() -> ca.Function:
         npar = len(dm.parameter_names)
         x = ca.SX.sym("x", dm.nx)
         u = ca.SX.sym("u", dm.nu)
@@ -40,11 +42,10 @@ def output_jacobian(dm: DerivedModel, channels: tuple[str, ...], ntheta: int,
         fn = ca.Function("output_jacobian", [x, u, p0, Sv, th, t],
                          [ca.jacobian(y, x), ca.jacobian(y, u), ca.jacobian(y, th)])
         if compiled:
-            from derive._compile import compiled as compile_fn
-
             fn = compile_fn(fn)
-        dm._memo[key] = fn
-    return dm._memo[key]
+        return fn
+
+    return dm.memo(key, build)
 
 
 def force_residual_jacobian(dm: DerivedModel, channels: tuple[str, ...], X: ca.MX,

@@ -25,7 +25,7 @@ __all__ = ["CaseTerms", "WarmStart", "case_terms"]
 
 def _measured_output(dm, channels: tuple[str, ...]) -> ca.Function:
     """``(x, u, p, t) -> y``: the measured ``channels`` (built once per model)."""
-    return dm.memoized(("measured_output", channels),
+    return dm.memo(("measured_output", channels),
                        lambda: _measured_output_function(dm, channels))
 
 

@@ -20,6 +20,7 @@ import casadi as ca
 import numpy as np
 
 from derive import DerivedModel, Excitation, rk4_step
+from derive import compiled as compile_fn
 from derive.simulate import interval_inputs
 
 from ._sparse import affine_parameters, scatter
@@ -138,10 +139,7 @@ class MultipleShooting(Transcription):
 
 def _compiled_step(dm: DerivedModel, substeps: int) -> ca.Function:
     """:func:`derive.rk4_step` compiled to C (once per model and substeps)."""
-    from derive._compile import compiled as compile_fn
-
-    return dm.memoized(("rk4_step_compiled", substeps),
-                       lambda: compile_fn(rk4_step(dm, substeps)))
+    return dm.memo(("rk4_step_compiled", substeps), lambda: compile_fn(rk4_step(dm, substeps)))
 
 
 def _step_jacobian(dm: DerivedModel, substeps: int, ntheta: int, compiled: bool) -> ca.Function:
@@ -149,7 +147,8 @@ def _step_jacobian(dm: DerivedModel, substeps: int, ntheta: int, compiled: bool)
     (dx_next/dU)^T)`` with ``p = p0 + S theta``; blocks are transposed so that mapped outputs
     stack by rows. Built (and compiled) once per model, substeps and number of estimates."""
     key = ("rk4_jacobian", substeps, ntheta, compiled, 2)
-    if key not in dm._memo:
+
+    def build() -> ca.Function:
         step = rk4_step(dm, substeps)
         npar = len(dm.parameter_names)
         x = ca.SX.sym("x", dm.nx)
@@ -163,11 +162,10 @@ def _step_jacobian(dm: DerivedModel, substeps: int, ntheta: int, compiled: bool)
                          [xn, ca.jacobian(xn, x).T, ca.jacobian(xn, th).T,
                           ca.jacobian(xn, U).T])
         if compiled:
-            from derive._compile import compiled as compile_fn
-
             fn = compile_fn(fn)
-        dm._memo[key] = fn
-    return dm._memo[key]
+        return fn
+
+    return dm.memo(key, build)
 
 
 def _bidiagonal(nx: int, n: int, negJ: ca.MX, *, fixed_start: bool) -> ca.MX:

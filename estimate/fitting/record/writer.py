@@ -108,8 +108,8 @@ def fit_record(result: "FitResult", *, model_spec: str | None = None,
     model_spec : str, optional
         The model specification as the user gave it (``--model``), kept in the provenance;
         the record's ``model_spec`` is the specification that rebuilds the fitted model
-        (:func:`estimate.data.models.model_spec`), or this one when the model has no
-        specification.
+        (:meth:`analogs.Model.spec`: as given when the model was built from one), or this
+        one when the model has no specification.
     options : mapping, optional
         The options of the command that made the fit, kept in the provenance.
     command : str, optional
@@ -124,8 +124,6 @@ def fit_record(result: "FitResult", *, model_spec: str | None = None,
     >>> record["schema"], record["parameters"]["p1.mass"]["interval_95"]   # doctest: +SKIP
     ('slosh-analogs/fit/2', [1.2958, 1.3044])
     """
-    from ...data.models import model_spec as spec_of
-
     problem = result.problem
     model = problem.model
     free = result.free
@@ -134,7 +132,7 @@ def fit_record(result: "FitResult", *, model_spec: str | None = None,
     return {
         "schema": SCHEMA,
         "model": model.names,
-        "model_spec": spec_of(model) or model_spec or ",".join(model.names),
+        "model_spec": model.spec() or model_spec or ",".join(model.names),
         "cases": [str(e.case.path) for e in experiments],
         "parameters": _parameters(result),
         # estimates at a bound have no covariance: both matrices hold the others only

@@ -98,7 +98,7 @@ def test_no_source_for_a_height_is_a_clear_error(spinning_case_with_prediction, 
     def broken(case, modes):
         raise InputError("fill fraction outside the solver's range")
 
-    monkeypatch.setattr(initial, "_tank_prediction", broken)
+    monkeypatch.setattr(initial, "case_prediction", broken)
     case = spinning_case_with_prediction
     with pytest.raises(InputError, match=r"no initial value for `fixed.height`, .*"
                                          r"`p1.hinge_height`: the tank modal analysis failed: fill "

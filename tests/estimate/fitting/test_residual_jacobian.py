@@ -13,7 +13,7 @@ from synthetic_cases import make_case, pendulum
 
 from estimate import FitProblem, model_from_spec
 from estimate.fitting.measurement import SensorDelay, SensorOffset
-from estimate.fitting.nlp import _setup
+from estimate.fitting.assembly import assemble_nlp as _setup
 from estimate.fitting.transcription import MultipleShooting
 
 

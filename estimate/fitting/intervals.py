@@ -1,0 +1,157 @@
+"""What a fit's covariances say about its estimates: intervals (Wald, or one-sided from a
+bound), the standard errors of either covariance, where the Gauss-Newton ones are
+optimistic, and the notes that say which covariance the report uses and why
+(:class:`ResultIntervals`, a base of :class:`~estimate.fitting.result.FitResult`)."""
+
+from __future__ import annotations
+
+import math
+
+import numpy as np
+
+from analogs.errors import InputError
+
+__all__ = ["OPTIMISTIC_FACTOR", "ResultIntervals"]
+
+_PROFILE_HINT = "`profile_interval` gives a profile-likelihood interval of a chosen parameter."
+#: The fit report calls the Gauss-Newton standard error of an estimate optimistic when the
+#: robust one exceeds it by more than this factor.
+OPTIMISTIC_FACTOR = 1.5
+
+
+class ResultIntervals:
+    """The intervals and standard errors of a fit result, read from its fields
+    (``values``, ``stderr``, ``covariance_kind``, ``at_bound``, ``bound_stderr``, ``dof``,
+    the two covariances, ``model_error``): methods only, for
+    :class:`~estimate.fitting.result.FitResult`."""
+
+    def interval(self, name: str, level: float = 0.95) -> tuple[float, float]:
+        """The ``level`` (default 0.95) interval of the estimate ``name``: the Wald interval
+        from :attr:`stderr` (the covariance ``covariance_kind`` names; t distribution); for
+        an estimate at a bound the one-sided interval from the bound
+        (:meth:`one_sided_limit`), up to the other bound when the data do not determine
+        it."""
+        from scipy.stats import t as student
+
+        i = self._index(name)
+        if not self.free[i]:
+            e = self.problem.estimated[i]
+            limit = self.one_sided_limit(name, level)
+            if self.at_bound[i] == "lower":
+                return float(e.lower), (float(e.upper) if limit is None else limit)
+            return (float(e.lower) if limit is None else limit), float(e.upper)
+        q = student.ppf(0.5 + level / 2, self.dof)
+        return float(self.values[i] - q * self.stderr[i]), float(self.values[i] + q * self.stderr[i])
+
+    def one_sided_limit(self, name: str, level: float = 0.95) -> float | None:
+        """For an estimate ``name`` at a bound: the one-sided ``level`` confidence limit away
+        from the bound (``bound +/- t_level * bound_stderr``), ``None`` when the data do not
+        determine it; raises for an estimate inside its bounds."""
+        from scipy.stats import t as student
+
+        i = self._index(name)
+        side = self.at_bound[i] if self.at_bound else None
+        if side is None:
+            raise InputError(f"`{name}` is not at a bound; use `interval`")
+        se = float(self.bound_stderr[i]) if self.bound_stderr is not None else math.nan
+        if not math.isfinite(se):
+            return None
+        q = float(student.ppf(level, self.dof))
+        e = self.problem.estimated[i]
+        return float(e.lower + q * se) if side == "lower" else float(e.upper - q * se)
+
+    def uncertainty_text(self, i: int) -> str:
+        """``+/- se`` of estimate ``i``, or what stands for it at a bound."""
+        if self.free[i]:
+            return f"+/- {self.stderr[i]:.3g}"
+        e = self.problem.estimated[i]
+        side = self.at_bound[i]
+        limit = self.one_sided_limit(self.names[i])
+        bound = e.lower if side == "lower" else e.upper
+        if limit is None:
+            return f"at its {side} bound {bound:.6g} (not determined by the data)"
+        return (f"at its {side} bound {bound:.6g} (one-sided 95 %: "
+                f"{'<=' if side == 'lower' else '>='} {limit:.3g})")
+
+    @property
+    def gauss_newton_stderr(self) -> np.ndarray:
+        """Standard errors from the Gauss-Newton covariance (independent residuals; NaN at a
+        bound)."""
+        return self._stderr(self.gauss_newton_covariance)
+
+    @property
+    def robust_stderr(self) -> np.ndarray:
+        """Standard errors from the covariance robust to autocorrelated residuals (NaN at a
+        bound, or when it was not computed)."""
+        return self._stderr(self.robust_covariance)
+
+    def _stderr(self, cov: np.ndarray | None) -> np.ndarray:
+        if cov is None:
+            return np.full(len(self.names), np.nan)
+        se = np.sqrt(np.clip(np.diag(cov), 0, None))
+        return np.where(np.array(self.free, bool), se, np.nan)
+
+    def optimistic(self, factor: float = OPTIMISTIC_FACTOR) -> dict[str, float]:
+        """Estimates whose robust standard error exceeds the Gauss-Newton one by more than
+        ``factor``, with the ratio: there the residuals are correlated (coloured noise, a
+        filtered force, or an effect the model lacks) and the Gauss-Newton intervals are
+        optimistic."""
+        gn, rb = self.gauss_newton_stderr, self.robust_stderr
+        with np.errstate(invalid="ignore", divide="ignore"):
+            ratio = rb / gn
+        return {n: float(r) for n, r in zip(self.names, ratio) if np.isfinite(r) and r > factor}
+
+    @property
+    def noise_stderr(self) -> np.ndarray:
+        """The standard errors without the model-error widening (:attr:`model_error`): the
+        spread the noise alone gives the estimates (NaN at a bound)."""
+        return self.stderr / self.model_error
+
+    def interval_note(self) -> str:
+        """One sentence: which covariance the standard errors come from, and where the
+        Gauss-Newton ones are optimistic."""
+        if self.covariance_kind != "robust":
+            return "Standard errors: Gauss-Newton covariance (independent residuals)."
+        worse = self.optimistic()
+        widened = (f" widened {self.model_error:.3g}x for model error (the residual over its "
+                   "noise figure);" if self.model_error > 1 else "")
+        return ("Standard errors: the covariance robust to correlated residuals (Newey-West);"
+                + widened + " "
+                + ("the Gauss-Newton ones, which assume independent residuals, are optimistic: "
+                   + ", ".join(f"{r:.2g}x smaller for `{n}`" for n, r in worse.items()) + "."
+                   if worse else f"the Gauss-Newton ones agree within {OPTIMISTIC_FACTOR:g}x."))
+
+    def covariance_note(self) -> str:
+        """Which covariance the standard errors and intervals come from, and why."""
+        p = self.problem
+        text = ("Standard errors and intervals: the covariance robust to correlated residuals "
+                "(a sandwich whose middle is the Newey-West long-run covariance of the "
+                "parameters' scores" if self.covariance_kind == "robust" else
+                "Standard errors and intervals: the Gauss-Newton covariance (independent "
+                "residuals")
+        text += ("; beside it the Gauss-Newton covariance of the whole NLP, states "
+                 "eliminated through the dynamics" if self.covariance_kind == "robust" else "")
+        if p.input == "estimated" and any(c is not None for c in p.carriage):
+            text += ("; force and displacement residuals divided by their noise figures, the "
+                     "carriage motion estimated and marginalised")
+        text += (f"; scaled by the residual variance {self.residual_variance:.3g}, "
+                 f"{self.dof} degrees of freedom). ")
+        if p.force_cutoff_hz is not None:
+            text += (f"The force was low-passed at {p.force_cutoff_hz:g} Hz, which correlates "
+                     "neighbouring residuals, and the input was treated as exact. ")
+        if self.covariance_kind == "robust":
+            text += ("The robust one is used because it equals the Gauss-Newton one when the "
+                     "residuals are white and widens when they are not (coloured transducer "
+                     "noise, a filtered force, an effect the model lacks), where the "
+                     "Gauss-Newton one is optimistic. ")
+            if self.model_error > 1:
+                text += (f"The residual is {self.model_error:.3g} times its noise figure: the "
+                         "model misses something the noise does not explain, whose bias a "
+                         "covariance of the noise does not bound, so the robust standard "
+                         f"errors are widened by that factor (model error). ")
+            worse = self.optimistic()
+            if worse:
+                text += ("Here the Gauss-Newton standard errors are optimistic: the robust ones "
+                         "are " + ", ".join(f"{r:.2g}x for `{n}`" for n, r in worse.items())
+                         + ". ")
+        return text + _PROFILE_HINT
