@@ -12,8 +12,8 @@ import reference_models as ref
 from synthetic_cases import make_case, pendulum
 
 from estimate import FitProblem, model_from_spec
-from estimate.fitting.measurement import SensorDelay, SensorOffset
 from estimate.fitting.assembly import assemble_nlp as _setup
+from estimate.fitting.measurement import SensorDelay, SensorOffset
 from estimate.fitting.transcription import MultipleShooting
 
 
