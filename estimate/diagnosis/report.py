@@ -3,6 +3,7 @@ a test engineer can read in a minute."""
 
 from __future__ import annotations
 
+import math
 from pathlib import Path
 
 import numpy as np
@@ -12,7 +13,8 @@ from ..data.signals import welch_spectrum
 from ..fitting.plots import drive_frequency_of, mode_frequencies, noise_density, spectrum_top
 from ..fitting.result import FitResult
 from ..outputs import json_text
-from .outcome import Diagnosis
+from .outcome import CandidateOutcome, Diagnosis
+from .scoring import HELD_OUT_BLOCKS, HOLDOUT_BLOCKS
 
 __all__ = ["REPORT_FILES", "write_report", "summary", "before_after_figure", "residual_spectra_figure"]
 
@@ -51,12 +53,36 @@ def _parameter_rows(res: FitResult) -> list[str]:
     return rows
 
 
-def _candidate_row(i: int, c, accepted: bool) -> str:
+def _candidate_row(i: int, c: CandidateOutcome, accepted: bool) -> str:
+    """A row of the candidates table. A candidate that was not fitted (screened out, not
+    tried) has no held-out gain and no BIC change: "-" in both, its verdict says why."""
     verdict = "accepted" if accepted else (c.rejected or "smaller gain")
-    if c.fitted:
-        return (f"| {i} | {c.cause} | {', '.join(c.added)} | {100 * c.gain:.1f} % | "
-                f"{c.bic_change:+.0f} | {verdict} |")
-    return f"| {i} | {c.cause} | {', '.join(c.added)} | not fitted | | {verdict} |"
+    gain = (f"{_unsigned_zero(100 * c.gain, 1):.1f} %"
+            if c.gain is not None and math.isfinite(c.gain) else "-")
+    dbic = (f"{_unsigned_zero(c.bic_change, 0):+.0f}"
+            if c.bic_change is not None and math.isfinite(c.bic_change) else "-")
+    return f"| {i} | {c.cause} | {', '.join(c.added)} | {gain} | {dbic} | {verdict} |"
+
+
+def _unsigned_zero(x: float, digits: int) -> float:
+    """``x`` rounded to ``digits`` decimals, a negative zero made positive (a null delay
+    prints as "0.0 ms", not "-0.0 ms")."""
+    return round(x, digits) + 0.0
+
+
+def _held_out_text() -> str:
+    """How the diagnosis holds data out: ``"3 of 10 interleaved blocks"``
+    (:data:`~estimate.diagnosis.scoring.HELD_OUT_BLOCKS`)."""
+    return f"{len(HELD_OUT_BLOCKS)} of {HOLDOUT_BLOCKS} interleaved blocks"
+
+
+def _fitted_on(res: FitResult) -> str:
+    """What a fit of the diagnosis was fitted on, for a heading."""
+    if not res.weights or all(np.all(w > 0) for w in res.weights):
+        return "every sample"
+    kept = HOLDOUT_BLOCKS - len(HELD_OUT_BLOCKS)
+    return (f"{kept} of {HOLDOUT_BLOCKS} interleaved blocks; the other {len(HELD_OUT_BLOCKS)} "
+            "held out to score the candidates")
 
 
 def summary(d: Diagnosis) -> str:
@@ -94,8 +120,9 @@ def summary(d: Diagnosis) -> str:
     lines.append(f"- Whiteness: Ljung-Box Q = {ev.ljung_box_q:.0f} (20 lags), p = {ev.ljung_box_p:.2g} "
                  f"({white}" + (f"; the {cut:g} Hz force filter itself correlates neighbouring "
                                 "samples" if cut else "") + ").")
-    lines.append(f"- Timing skew: correlation of the residual with dF/dt {ev.skew_correlation:+.2f} "
-                 f"(implied delay {1e3 * ev.skew_delay:.1f} ms).")
+    lines.append(f"- Timing skew: correlation of the residual with dF/dt "
+                 f"{_unsigned_zero(ev.skew_correlation, 2):+.2f} "
+                 f"(implied delay {_unsigned_zero(1e3 * ev.skew_delay, 1):.1f} ms).")
     if ev.frequency_ratio:
         lines.append(f"- Fitted first-mode frequency / predicted: {ev.frequency_ratio:.3f}.")
     if ev.pinned:
@@ -110,8 +137,8 @@ def summary(d: Diagnosis) -> str:
         for i, rnd in enumerate(d.rounds, 1):
             lines += [_candidate_row(i, c, c.fitted and accepted.get(i) == c.added) for c in rnd]
     lines += ["", "## Final parameters", ""] + _parameter_rows(d.final)
-    lines += ["", f"{d.candidate_fits} fits in {d.seconds:.1f} s. Held-out RMS: 3 of 10 interleaved "
-              f"blocks left out of every fit but the final one. {d.final.interval_note()}", ""]
+    lines += ["", f"{d.candidate_fits} fits in {d.seconds:.1f} s. Held-out RMS: {_held_out_text()} "
+              f"left out of every fit but the final one. {d.final.interval_note()}", ""]
     ended = d.budget_ended
     if ended:
         lines += ["Fits ended by their budget (iterations or CPU time, scaled with the record):", ""]
@@ -132,11 +159,9 @@ def write_report(d: Diagnosis, folder: str | Path, *, overwrite: bool = False) -
                dpi=100)
     style.save(residual_spectra_figure(d, folder / "residual_spectra.png"),
                folder / "residual_spectra.png", dpi=100)
-    held = "3 of 10 interleaved blocks held out" if d.baseline.weights else "every sample"
-    (folder / "parameters.md").write_text("\n".join([f"# Baseline (fitted on {held})", ""]
-                                                    + _parameter_rows(d.baseline)
-                                                    + ["", "# Final (fitted on every sample)", ""]
-                                                    + _parameter_rows(d.final)) + "\n")
+    (folder / "parameters.md").write_text("\n".join(
+        [f"# Baseline (fitted on {_fitted_on(d.baseline)})", ""] + _parameter_rows(d.baseline)
+        + ["", f"# Final (fitted on {_fitted_on(d.final)})", ""] + _parameter_rows(d.final)) + "\n")
     (folder / "summary.md").write_text(summary(d))
     (folder / "diagnosis.json").write_text(json_text(d.to_dict()))
     return folder / "summary.md"
