@@ -200,20 +200,19 @@ def before_after_figure(d: Diagnosis, path: str | Path | None = None):
     ax[0].plot(t, base, **base_style, label=f"baseline ({_model_text(d.baseline)})")
     ax[0].plot(t, final, **final_style, label=f"final ({_model_text(d.final)})")
     top = float(np.max(np.abs(meas))) or 1.0
-    ax[0].set(ylabel="force_x [N]", ylim=(-1.1 * top, 2.9 * top), xlim=(t[0], t[-1]))
+    ax[0].set(ylabel="force_x [N]", ylim=(-1.1 * top, style.ZOOM_TOP * top), xlim=(t[0], t[-1]))
     ax[0].set_yticks([tk for tk in ax[0].get_yticks() if abs(tk) <= 1.1 * top])
     end = style.startup_end(t)
     span = max(1.0, 0.06 * (t[-1] - t[0]), end - t[0])
-    for (lo, hi), bounds, name in (((t[0], t[0] + span), [0.04, 0.6, 0.42, 0.38], "start-up"),
-                                   ((t[-1] - span, t[-1]), [0.54, 0.6, 0.42, 0.38], "steady")):
+    for (lo, hi), bounds, name in zip(((t[0], t[0] + span), (t[-1] - span, t[-1])),
+                                      style.ZOOM_BOXES, ("start-up", "steady")):
         inset = ax[0].inset_axes(bounds)
         keep = (t >= lo) & (t <= hi)
         inset.plot(t[keep], meas[keep], **style.MEASURED)
         inset.plot(t[keep], base[keep], **base_style)
         inset.plot(t[keep], final[keep], **final_style)
         inset.set_xlim(lo, hi)
-        inset.tick_params(labelsize="x-small")
-        inset.set_title(f"{name}: {lo:.1f}-{hi:.1f} s", fontsize="x-small", pad=2)
+        style.label_inset(inset, f"{name}: {lo:.1f}-{hi:.1f} s")
         ax[0].indicate_inset_zoom(inset, edgecolor="0.4")
     ax[0].legend(loc="lower left", bbox_to_anchor=(0, 1.0), ncols=3, fontsize="small", frameon=False)
     steady = t > end

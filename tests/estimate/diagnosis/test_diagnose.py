@@ -143,6 +143,7 @@ def _check_report_figures(d, folder):
     assert_distinguishable(line(force, "measured"), line(force, "final"))
     assert_distinguishable(line(force, "measured"), line(force, "baseline"))
     assert len(force.child_axes) == 2
+    assert all(inset.title.get_fontsize() >= 8 for inset in force.child_axes)
     t, r = d.baseline.problem.experiments[0].case.time, d.baseline.residuals[0]
     # the residual axis is a fraction of the force axis, set by the baseline residual
     assert base.get_ylim()[1] < 0.5 * force.get_ylim()[1]
