@@ -20,10 +20,19 @@ def shows_progress(enabled: bool | None = None) -> bool:
     return bool(getattr(stream, "isatty", None) and stream.isatty())
 
 
+#: The line of a bar without a total: ``diagnose: 3 fits [00:05, round 1: candidates]``.
+#: tqdm's own adds the rate, which for slow steps it inverts to "1.61s/ fits" (the unit's
+#: leading space is what separates it from the count).
+UNCOUNTED_FORMAT = "{desc}: {n_fmt}{unit} [{elapsed}{postfix}]"
+
+
 def progress(*, total: int | None, desc: str, unit: str = "it", enabled: bool | None = None):
     """A :class:`tqdm.tqdm` bar on standard error (a disabled one when
-    :func:`shows_progress` says no); use as a context manager and call ``update()``."""
+    :func:`shows_progress` says no); use as a context manager and call ``update()``.
+    Without a ``total`` the line counts in ``unit`` (give it its leading space, ``" fits"``)
+    and shows the elapsed time (:data:`UNCOUNTED_FORMAT`)."""
     from tqdm import tqdm
 
     return tqdm(total=total, desc=desc, unit=unit, disable=not shows_progress(enabled),
-                leave=False, file=sys.stderr, dynamic_ncols=True)
+                leave=False, file=sys.stderr, dynamic_ncols=True,
+                bar_format=UNCOUNTED_FORMAT if total is None else None)

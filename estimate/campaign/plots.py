@@ -53,10 +53,12 @@ def plotted_quantities(table: CampaignTable, pendulums: int) -> list[str]:
     return [q for q in wanted if q in table.quantities]
 
 
-def _title(q: str, unit: str) -> str:
+def _title(q: str, unit: str | None) -> str:
+    """A panel's title: ``"pendulum mass (p1.mass) [kg]"``; without the unit (``None``) on
+    a panel whose axis is in per cent."""
     comp, _, name = q.partition(".")
     label = _LABELS.get(q) or f"{comp} {_LABELS.get(name, name)}"
-    return f"{label} `{q}`" + (f" [{unit}]" if unit and unit != "-" else "")
+    return f"{label} ({q})" + (f" [{unit}]" if unit and unit != "-" else "")
 
 
 def _values(rows: Sequence[dict[str, Any]], q: str, unit: str) -> tuple[np.ndarray, ...]:
@@ -212,7 +214,7 @@ def plot_against_amplitude(table: CampaignTable, quantities: Sequence[str], path
         ax.xaxis.set_major_locator(LogLocator(subs=(1.0, 2.0, 3.0, 5.0)))
         ax.xaxis.set_major_formatter(lambda x, _: f"{x:g}")
         ax.xaxis.set_minor_locator(NullLocator())
-        ax.set_title(_title(q, unit), fontsize=10)
+        ax.set_title(_title(q, None), fontsize=10)  # the axis is in per cent, not in the unit
         ax.set_ylabel("% from the group fit", fontsize=9)
         ax.set_xlabel("drive amplitude [mm]")
         ax.grid(alpha=0.3)

@@ -90,6 +90,25 @@ def _spans(x, flag) -> list[tuple[float, float]]:
     return [(float(x[a]) - step / 2, float(x[b - 1]) + step / 2) for a, b in zip(edges[::2], edges[1::2])]
 
 
+def _label_beside_curve(ax, x: float, y: float, text: str, xs, ys, *, low: bool) -> None:
+    """Write ``text`` beside the point ``(x, y)`` of the curve ``(xs, ys)`` where the curve
+    leaves room (a label level with the point lay on a flat curve): below it on the right
+    where the curve rises or stays level to the right of ``x``, above it on the right where
+    it falls; ``low`` (the point near the bottom of the axis): above it, on the left of a
+    rising curve."""
+    import numpy as np
+
+    xs, ys = np.asarray(xs, float), np.asarray(ys, float)
+    right = ys[xs > x][:2]
+    falls = right.size > 0 and bool(np.nanmax(right) < y)
+    above = falls or low
+    left = low and not falls
+    ax.annotate(text, (x, y), xytext=(-6 if left else 6, 6 if above else -6),
+                textcoords="offset points", ha="right" if left else "left",
+                va="bottom" if above else "top", color="#b2182b", fontsize="small",
+                gid="requested fill label")
+
+
 def _plot(args: argparse.Namespace, tank, liquid: Liquid, path: str, pred) -> None:
     import numpy as np
     from matplotlib.figure import Figure
@@ -140,8 +159,12 @@ def _plot(args: argparse.Namespace, tank, liquid: Liquid, path: str, pred) -> No
                color="#b2182b", ms=6, zorder=4)
     ax[1].plot([req] * args.modes, [m.frequency_hz for m in pred.modes], "D", color="#b2182b", ms=6,
                zorder=4)
-    ax[1].annotate(f"{pred.modes[0].frequency_hz:.3g} Hz", (req, pred.modes[0].frequency_hz),
-                   xytext=(6, -4), textcoords="offset points", color="#b2182b", fontsize="small")
+    curves = np.array([[r.modes[n].frequency_hz for r in rows] for n in range(args.modes)])
+    lo, hi = float(np.nanmin(curves)), float(np.nanmax(curves))
+    for n, mode in enumerate(pred.modes):
+        low = mode.frequency_hz - lo < 0.15 * (hi - lo)  # room for the text below it?
+        _label_beside_curve(ax[1], req, mode.frequency_hz, f"{mode.frequency_hz:.3g} Hz", pct,
+                            curves[n], low=low)
     # volume fill on the top axis (monotone in the height fill)
     grid = np.linspace(0.0, 1.0, 401)
     vol = np.array([tank.volume(g * tank.height) for g in grid]) / tank.volume()

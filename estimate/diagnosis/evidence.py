@@ -16,12 +16,15 @@ from ..fitting.result import FitResult
 from .scoring import ResidualOverNoise, noise_figure
 
 __all__ = ["Evidence", "ResidualPeak", "SegmentDamping", "Trend", "amplitude_trend",
-           "collect_evidence"]
+           "collect_evidence", "SIGNIFICANT_T"]
 
 #: Residual peaks weaker than this fraction of the force amplitude are ignored.
 PEAK_FLOOR = 0.003
 #: Relative tolerance for calling a frequency a harmonic of the drive.
 HARMONIC_TOL = 0.03
+#: A :class:`Trend` whose slope is fewer standard errors than this from zero is no trend:
+#: its text says so, and the families' evidence leaves it out.
+SIGNIFICANT_T = 2.0
 
 
 @dataclass(frozen=True)
@@ -72,14 +75,21 @@ class Trend:
         return self.values[1] / self.values[0] if self.values[0] else math.nan
 
     def text(self) -> str:
-        """``"damping ratio falls x0.50 from 0.1 rad to 0.35 rad (6.2 standard errors)"``."""
+        """``"damping ratio falls x0.50 from 0.1 rad to 0.35 rad swing (slope 6.2 standard
+        errors)"``, ``"frequency falls 1.2 % from ..."``. A slope within
+        :data:`SIGNIFICANT_T` standard errors of zero is no trend: ``"frequency: no significant
+        change (-0.0082 %) from ..."``, never a "falls -0.0 %" or a "falls x1.00"."""
+        span = (f"from {self.amplitudes[0]:.2g} rad to {self.amplitudes[1]:.2g} rad swing "
+                f"(slope {abs(self.t):.1f} standard errors)")
+        pct = 100 * (self.ratio - 1)
+        factor = self.quantity != "frequency" and abs(pct) >= 5  # damping: x0.50, x2.0
+        if abs(self.t) < SIGNIFICANT_T:
+            size = (f"x{self.ratio:.2f}" if factor else f"{pct:+.2g} %") if math.isfinite(pct) else ""
+            return f"{self.quantity}: no significant change{f' ({size})' if size else ''} {span}"
         moves = "rises" if self.slope > 0 else "falls"
-        if self.quantity == "frequency":
-            change = f"{100 * (self.ratio - 1):+.1f} %"
-        else:
-            change = f"x{self.ratio:.2f}"
-        return (f"{self.quantity} {moves} {change} from {self.amplitudes[0]:.2g} rad to "
-                f"{self.amplitudes[1]:.2g} rad swing ({abs(self.t):.1f} standard errors)")
+        size = ((f"x{self.ratio:.2f} " if factor else f"{abs(pct):.2g} % ")
+                if math.isfinite(pct) else "")
+        return f"{self.quantity} {moves} {size}{span}"
 
 
 def amplitude_trend(segments: tuple[SegmentDamping, ...], quantity: str) -> Trend | None:

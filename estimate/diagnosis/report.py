@@ -3,6 +3,7 @@ a test engineer can read in a minute."""
 
 from __future__ import annotations
 
+import math
 from pathlib import Path
 
 import numpy as np
@@ -12,7 +13,8 @@ from ..data.signals import welch_spectrum
 from ..fitting.plots import drive_frequency_of, mode_frequencies, noise_density, spectrum_top
 from ..fitting.result import FitResult
 from ..outputs import json_text
-from .outcome import Diagnosis
+from .outcome import CandidateOutcome, Diagnosis
+from .scoring import HELD_OUT_BLOCKS, HOLDOUT_BLOCKS
 
 __all__ = ["REPORT_FILES", "write_report", "summary", "before_after_figure", "residual_spectra_figure"]
 
@@ -51,12 +53,36 @@ def _parameter_rows(res: FitResult) -> list[str]:
     return rows
 
 
-def _candidate_row(i: int, c, accepted: bool) -> str:
+def _candidate_row(i: int, c: CandidateOutcome, accepted: bool) -> str:
+    """A row of the candidates table. A candidate that was not fitted (screened out, not
+    tried) has no held-out gain and no BIC change: "-" in both, its verdict says why."""
     verdict = "accepted" if accepted else (c.rejected or "smaller gain")
-    if c.fitted:
-        return (f"| {i} | {c.cause} | {', '.join(c.added)} | {100 * c.gain:.1f} % | "
-                f"{c.bic_change:+.0f} | {verdict} |")
-    return f"| {i} | {c.cause} | {', '.join(c.added)} | not fitted | | {verdict} |"
+    gain = (f"{_unsigned_zero(100 * c.gain, 1):.1f} %"
+            if c.gain is not None and math.isfinite(c.gain) else "-")
+    dbic = (f"{_unsigned_zero(c.bic_change, 0):+.0f}"
+            if c.bic_change is not None and math.isfinite(c.bic_change) else "-")
+    return f"| {i} | {c.cause} | {', '.join(c.added)} | {gain} | {dbic} | {verdict} |"
+
+
+def _unsigned_zero(x: float, digits: int) -> float:
+    """``x`` rounded to ``digits`` decimals, a negative zero made positive (a null delay
+    prints as "0.0 ms", not "-0.0 ms")."""
+    return round(x, digits) + 0.0
+
+
+def _held_out_text() -> str:
+    """How the diagnosis holds data out: ``"3 of 10 interleaved blocks"``
+    (:data:`~estimate.diagnosis.scoring.HELD_OUT_BLOCKS`)."""
+    return f"{len(HELD_OUT_BLOCKS)} of {HOLDOUT_BLOCKS} interleaved blocks"
+
+
+def _fitted_on(res: FitResult) -> str:
+    """What a fit of the diagnosis was fitted on, for a heading."""
+    if not res.weights or all(np.all(w > 0) for w in res.weights):
+        return "every sample"
+    kept = HOLDOUT_BLOCKS - len(HELD_OUT_BLOCKS)
+    return (f"{kept} of {HOLDOUT_BLOCKS} interleaved blocks; the other {len(HELD_OUT_BLOCKS)} "
+            "held out to score the candidates")
 
 
 def summary(d: Diagnosis) -> str:
@@ -94,8 +120,9 @@ def summary(d: Diagnosis) -> str:
     lines.append(f"- Whiteness: Ljung-Box Q = {ev.ljung_box_q:.0f} (20 lags), p = {ev.ljung_box_p:.2g} "
                  f"({white}" + (f"; the {cut:g} Hz force filter itself correlates neighbouring "
                                 "samples" if cut else "") + ").")
-    lines.append(f"- Timing skew: correlation of the residual with dF/dt {ev.skew_correlation:+.2f} "
-                 f"(implied delay {1e3 * ev.skew_delay:.1f} ms).")
+    lines.append(f"- Timing skew: correlation of the residual with dF/dt "
+                 f"{_unsigned_zero(ev.skew_correlation, 2):+.2f} "
+                 f"(implied delay {_unsigned_zero(1e3 * ev.skew_delay, 1):.1f} ms).")
     if ev.frequency_ratio:
         lines.append(f"- Fitted first-mode frequency / predicted: {ev.frequency_ratio:.3f}.")
     if ev.pinned:
@@ -110,8 +137,8 @@ def summary(d: Diagnosis) -> str:
         for i, rnd in enumerate(d.rounds, 1):
             lines += [_candidate_row(i, c, c.fitted and accepted.get(i) == c.added) for c in rnd]
     lines += ["", "## Final parameters", ""] + _parameter_rows(d.final)
-    lines += ["", f"{d.candidate_fits} fits in {d.seconds:.1f} s. Held-out RMS: 3 of 10 interleaved "
-              f"blocks left out of every fit but the final one. {d.final.interval_note()}", ""]
+    lines += ["", f"{d.candidate_fits} fits in {d.seconds:.1f} s. Held-out RMS: {_held_out_text()} "
+              f"left out of every fit but the final one. {d.final.interval_note()}", ""]
     ended = d.budget_ended
     if ended:
         lines += ["Fits ended by their budget (iterations or CPU time, scaled with the record):", ""]
@@ -132,11 +159,9 @@ def write_report(d: Diagnosis, folder: str | Path, *, overwrite: bool = False) -
                dpi=100)
     style.save(residual_spectra_figure(d, folder / "residual_spectra.png"),
                folder / "residual_spectra.png", dpi=100)
-    held = "3 of 10 interleaved blocks held out" if d.baseline.weights else "every sample"
-    (folder / "parameters.md").write_text("\n".join([f"# Baseline (fitted on {held})", ""]
-                                                    + _parameter_rows(d.baseline)
-                                                    + ["", "# Final (fitted on every sample)", ""]
-                                                    + _parameter_rows(d.final)) + "\n")
+    (folder / "parameters.md").write_text("\n".join(
+        [f"# Baseline (fitted on {_fitted_on(d.baseline)})", ""] + _parameter_rows(d.baseline)
+        + ["", f"# Final (fitted on {_fitted_on(d.final)})", ""] + _parameter_rows(d.final)) + "\n")
     (folder / "summary.md").write_text(summary(d))
     (folder / "diagnosis.json").write_text(json_text(d.to_dict()))
     return folder / "summary.md"
@@ -175,20 +200,19 @@ def before_after_figure(d: Diagnosis, path: str | Path | None = None):
     ax[0].plot(t, base, **base_style, label=f"baseline ({_model_text(d.baseline)})")
     ax[0].plot(t, final, **final_style, label=f"final ({_model_text(d.final)})")
     top = float(np.max(np.abs(meas))) or 1.0
-    ax[0].set(ylabel="force_x [N]", ylim=(-1.1 * top, 2.9 * top), xlim=(t[0], t[-1]))
+    ax[0].set(ylabel="force_x [N]", ylim=(-1.1 * top, style.ZOOM_TOP * top), xlim=(t[0], t[-1]))
     ax[0].set_yticks([tk for tk in ax[0].get_yticks() if abs(tk) <= 1.1 * top])
     end = style.startup_end(t)
     span = max(1.0, 0.06 * (t[-1] - t[0]), end - t[0])
-    for (lo, hi), bounds, name in (((t[0], t[0] + span), [0.04, 0.6, 0.42, 0.38], "start-up"),
-                                   ((t[-1] - span, t[-1]), [0.54, 0.6, 0.42, 0.38], "steady")):
+    for (lo, hi), bounds, name in zip(((t[0], t[0] + span), (t[-1] - span, t[-1])),
+                                      style.ZOOM_BOXES, ("start-up", "steady")):
         inset = ax[0].inset_axes(bounds)
         keep = (t >= lo) & (t <= hi)
         inset.plot(t[keep], meas[keep], **style.MEASURED)
         inset.plot(t[keep], base[keep], **base_style)
         inset.plot(t[keep], final[keep], **final_style)
         inset.set_xlim(lo, hi)
-        inset.tick_params(labelsize="x-small")
-        inset.set_title(f"{name}: {lo:.1f}-{hi:.1f} s", fontsize="x-small", pad=2)
+        style.label_inset(inset, f"{name}: {lo:.1f}-{hi:.1f} s")
         ax[0].indicate_inset_zoom(inset, edgecolor="0.4")
     ax[0].legend(loc="lower left", bbox_to_anchor=(0, 1.0), ncols=3, fontsize="small", frameon=False)
     steady = t > end

@@ -17,7 +17,7 @@ from ..fitting.result import FitResult
 
 __all__ = ["ResidualOverNoise", "noise_figure", "noise_floor", "within_noise", "holdout_weights",
            "heldout", "bic", "distinct", "case_rows", "far_from_noise", "poor_start",
-           "NOISE_MARGIN", "MIN_SCORE", "POOR_START_RATIO"]
+           "NOISE_MARGIN", "MIN_SCORE", "POOR_START_RATIO", "HOLDOUT_BLOCKS", "HELD_OUT_BLOCKS"]
 
 #: A residual this many times the measurement noise is within the noise: the fit's own
 #: margin, above which its intervals take the model error.
@@ -25,6 +25,11 @@ NOISE_MARGIN = MODEL_ERROR_MARGIN
 #: Score statistic a screened term (or a profiled sensor delay) needs to be fitted (5
 #: standard deviations for one new parameter: a dozen terms are screened each round).
 MIN_SCORE = 25.0
+#: The diagnosis cuts each record into this many blocks of equal length ...
+HOLDOUT_BLOCKS = 10
+#: ... and leaves these blocks (0-based: 3 of 10, spread over the record) out of every fit
+#: but the final one; the candidates are scored on them.
+HELD_OUT_BLOCKS = (1, 4, 7)
 
 
 @dataclass(frozen=True)
@@ -126,8 +131,10 @@ def case_rows(res: FitResult, case: int) -> slice:
     return slice(start, start + int(np.size(res.residuals[case])))
 
 
-def holdout_weights(n: int, *, blocks: int = 10, held: Sequence[int] = (1, 4, 7)) -> np.ndarray:
-    """Weights leaving out interleaved blocks (default 3 of 10) of an ``n``-sample record."""
+def holdout_weights(n: int, *, blocks: int = HOLDOUT_BLOCKS,
+                    held: Sequence[int] = HELD_OUT_BLOCKS) -> np.ndarray:
+    """Weights leaving out interleaved blocks (default :data:`HELD_OUT_BLOCKS`, 3 of
+    :data:`HOLDOUT_BLOCKS`) of an ``n``-sample record."""
     w = np.ones(n)
     edges = np.linspace(0, n, blocks + 1).astype(int)
     for b in held:

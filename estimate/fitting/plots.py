@@ -79,18 +79,17 @@ def _time_panel(ax, t, meas, sim, unit: str, name: str, *, zooms: bool,
         ax.legend(loc="lower left", bbox_to_anchor=(0, 1.0), ncols=2, fontsize="small", frameon=False)
         return
     # room above the trace for two zooms: the transient after the start-up and the steady end
-    ax.set_ylim(-1.1 * top, 2.9 * top)
+    ax.set_ylim(-1.1 * top, style.ZOOM_TOP * top)
     ax.set_yticks([tk for tk in ax.get_yticks() if abs(tk) <= 1.1 * top])
     end = style.startup_end(t)
-    boxes = ([0.04, 0.6, 0.42, 0.38], [0.54, 0.6, 0.42, 0.38])
-    for (lo, hi), bounds, title in zip(_zoom_windows(t, end), boxes, ("start-up", "steady")):
+    for (lo, hi), bounds, title in zip(_zoom_windows(t, end), style.ZOOM_BOXES,
+                                       ("start-up", "steady")):
         inset = ax.inset_axes(bounds)
         keep = (t >= lo) & (t <= hi)
         inset.plot(t[keep], meas[keep], **style.MEASURED)
         inset.plot(t[keep], sim[keep], **style.SIMULATED)
         inset.set_xlim(lo, hi)
-        inset.tick_params(labelsize="x-small")
-        inset.set_title(f"{title}: {lo:.1f}-{hi:.1f} s", fontsize="x-small", pad=2)
+        style.label_inset(inset, f"{title}: {lo:.1f}-{hi:.1f} s")
         ax.indicate_inset_zoom(inset, edgecolor="0.4")
     ax.legend(loc="lower left", bbox_to_anchor=(0, 1.0), ncols=2, fontsize="small", frameon=False)
 
@@ -249,7 +248,9 @@ def plot_fit(result: "FitResult", path: str | Path | None = None, *, case: int =
         _trajectory_panel(ax[-1], result)
     else:
         ax[-1].set_axis_off()
-    fig.suptitle(f"{exp.case.test.id}: {' + '.join(result.problem.model.names)} - RMS residual "
+    model = result.problem.model
+    # the model as fitted ("fixed,p1:nospring"), not only its components' names
+    fig.suptitle(f"{exp.case.test.id}: {model.spec() or ' + '.join(model.names)} - RMS residual "
                  f"{result.rms_residual:.3g} {'N' if single else '(scaled)'}, R^2 {result.r_squared:.5f}")
     style.save(fig, path, dpi=110)
     return fig

@@ -14,7 +14,7 @@ from analogs import Component, Model
 
 from ...fitting.measurement import MeasurementModel
 from ...fitting.result import FitResult
-from ..evidence import Evidence, segment_damping
+from ..evidence import SIGNIFICANT_T, Evidence, segment_damping
 from ..scoring import distinct
 
 if TYPE_CHECKING:
@@ -207,9 +207,10 @@ def free_name(model: Model, prefix: str) -> str:
 
 def trend_text(evidence: Evidence, quantity: str) -> str:
     """The amplitude trend of ``"damping"`` or ``"frequency"`` in words, when it is one (at
-    least 2 standard errors), with a trailing ``"; "``."""
+    least :data:`~estimate.diagnosis.evidence.SIGNIFICANT_T` standard errors), with a trailing
+    ``"; "``."""
     trend = evidence.damping_trend if quantity == "damping" else evidence.frequency_trend
-    return f"{trend.text()}; " if trend is not None and abs(trend.t) >= 2 else ""
+    return f"{trend.text()}; " if trend is not None and abs(trend.t) >= SIGNIFICANT_T else ""
 
 
 def screened_proposal(family: Family, score: Score, ctx: Context,

@@ -200,3 +200,21 @@ def test_campaign_outputs_get_the_mode_of_any_other_output(run, tmp_path):
                        out / "report", out / "report" / "report.md"]}
     assert modes == {"campaign.csv": 0o644, "campaign.parquet": 0o644, "campaign.json": 0o644,
                      "report": 0o755, "report/report.md": 0o644}
+
+
+def test_plot_titles_name_the_quantity_as_text_and_match_their_axes(run, tmp_path, monkeypatch):
+    """A figure draws Markdown backticks literally; the amplitude panels are in per cent of
+    the group's fit, so their titles carry no unit (the fill panels' values are in it)."""
+    from matplotlib.figure import Figure
+
+    from estimate.campaign.plots import _title, plot_against_amplitude
+
+    shown = []
+    monkeypatch.setattr(Figure, "savefig", lambda self, *a, **k: shown.append(self))
+    plot_against_amplitude(campaign_table(run), ["p1.mass", "p1.damping_ratio"], tmp_path / "a.png")
+    panels = [ax for ax in shown[0].axes if ax.get_visible()]
+    assert [ax.get_title() for ax in panels] == ["p1 pendulum mass (p1.mass)",
+                                                 "p1 damping ratio (p1.damping_ratio)"]
+    assert all(ax.get_ylabel() == "% from the group fit" for ax in panels)
+    assert _title("fixed.mass", "kg") == "fixed mass (fixed.mass) [kg]"
+    assert _title("p1.frequency_hz", "Hz") == "p1 frequency (p1.frequency_hz) [Hz]"

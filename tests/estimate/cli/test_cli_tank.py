@@ -52,6 +52,40 @@ def test_cli_volume_fill_legacy_and_plot(tmp_path):
     assert mass.child_axes[0].get_xlabel() == "fill [% of tank volume]"
 
 
+def test_the_frequency_labels_sit_beside_their_curves(tmp_path):
+    """A cylinder's mode frequencies are level with the fill above half full: a label level
+    with the requested fill's point lay on the curve. Each mode's label stays inside the
+    panel and off every curve."""
+    pytest.importorskip("matplotlib")
+    import numpy as np
+    from matplotlib.backends.backend_agg import FigureCanvasAgg
+
+    from analogs.tank import Cylinder
+
+    args = parse(["tank", "--shape", "cylinder", "--radius", "0.1016", "--length", "0.3",
+                  "--fill", "0.6", "--plot", str(tmp_path / "c.png")])
+    tank = Cylinder(0.1016, 0.3)
+    pred = predict(tank, fill=0.6)
+    fig = _cli_tank._plot(args, tank, pred.liquid, str(tmp_path / "c.png"), pred)
+    FigureCanvasAgg(fig).draw()
+    renderer = fig.canvas.get_renderer()
+    freq = fig.axes[1]
+    labels = [t for t in freq.texts if t.get_gid() == "requested fill label"]
+    assert [t.get_text() for t in labels] == [f"{m.frequency_hz:.3g} Hz" for m in pred.modes]
+    curves = [ln for ln in freq.get_lines() if ln.get_label().startswith("mode")]
+    assert len(curves) == len(pred.modes)
+    for text in labels:
+        box = text.get_window_extent(renderer)
+        assert freq.get_window_extent(renderer).contains(box.x0, box.y0)
+        assert freq.get_window_extent(renderer).contains(box.x1, box.y1)
+        for ln in curves:
+            x, y = (np.asarray(v, float) for v in ln.get_data())
+            fine = np.linspace(x[0], x[-1], 2000)  # the drawn segments, densely
+            px, py = freq.transData.transform(np.column_stack([fine, np.interp(fine, x, y)])).T
+            assert not np.any((px >= box.x0) & (px <= box.x1) & (py >= box.y0) & (py <= box.y1)), \
+                (text.get_text(), ln.get_label())
+
+
 def test_cli_bad_input_exits_2_with_message(capsys):
     assert main(["tank", "--shape", "cylinder", "--radius", "0.1", "--fill", "0.5"]) == 2
     assert "--shape cylinder takes `--radius`, `--length` (m); got none for `--length`" \

@@ -133,6 +133,7 @@ def _check_report_figures(d, folder):
 
     write_report(d, folder)
     assert (folder / "fit_before_after.png").stat().st_size > 10_000
+    _check_report_text(folder)
     fig = before_after_figure(d, folder / "again.png")
     force, base, final = fig.axes
     for ax in fig.axes:
@@ -142,6 +143,7 @@ def _check_report_figures(d, folder):
     assert_distinguishable(line(force, "measured"), line(force, "final"))
     assert_distinguishable(line(force, "measured"), line(force, "baseline"))
     assert len(force.child_axes) == 2
+    assert all(inset.title.get_fontsize() >= 8 for inset in force.child_axes)
     t, r = d.baseline.problem.experiments[0].case.time, d.baseline.residuals[0]
     # the residual axis is a fraction of the force axis, set by the baseline residual
     assert base.get_ylim()[1] < 0.5 * force.get_ylim()[1]
@@ -159,3 +161,26 @@ def _check_report_figures(d, folder):
     assert any(abs(f - 3.8) < 0.3 for f in marked(ax, "peak 1") + marked(ax, "peak 2"))
     data = np.concatenate([ln.get_ydata() for ln in ax.get_lines()[:3]])
     assert_ylim_fits(ax, data[data > 0], 1.5)
+
+
+def _check_report_text(folder):
+    """parameters.md says what each fit was fitted on and gives every row its unit (the
+    derived ones too); the summary's candidates that were not fitted show no gain or BIC
+    change, and no number prints as a negative zero."""
+    params = (folder / "parameters.md").read_text()
+    assert ("# Baseline (fitted on 7 of 10 interleaved blocks; the other 3 held out to score "
+            "the candidates)") in params
+    assert "# Final (fitted on every sample)" in params
+    rows = [[c.strip() for c in r.strip("|").split("|")] for r in params.splitlines()
+            if r.startswith("| `")]
+    assert any("(derived)" in r[0] for r in rows)
+    assert all(r[-1] for r in rows), [r for r in rows if not r[-1]]
+    text = (folder / "summary.md").read_text()
+    candidates = [[c.strip() for c in r.strip("|").split("|")] for r in
+                  text.split("## Candidates")[1].split("## Final parameters")[0].splitlines()
+                  if r.startswith("| ") and not r.startswith("| round")]
+    assert any(c[-1] == "accepted" for c in candidates)
+    for c in candidates:
+        if c[-1].startswith(("not tried", "screened")):
+            assert c[3:5] == ["-", "-"], c
+    assert "-0.0 " not in text

@@ -192,6 +192,11 @@ def test_fit_plot_shows_what_it_is_for(tmp_path):
     meas, sim = line(force, "measured"), line(force, "simulated")
     assert_distinguishable(meas, sim)
     assert len(force.child_axes) == 2  # zooms: the start-up and the steady end
+    for inset in force.child_axes:  # readable at the saved size
+        assert inset.title.get_fontsize() >= 8
+        assert all(lb.get_fontsize() >= 7 for lb in inset.get_xticklabels())
+    # the model as fitted: without its hinge spring
+    assert fig.get_suptitle().startswith("A1: fixed,p1:nospring - RMS residual")
     # the residual axis: set by the residual after the start-up, the start-up peak named
     t, r = case.time, res.residuals[0]
     steady = t > t[0] + 2.0
