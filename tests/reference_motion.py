@@ -55,9 +55,9 @@ Each motion axis is a sum of signals (:class:`RampedSine`, :class:`Move`); a ram
 faded in from rest by the quintic ``s(x) = 10 x^3 - 15 x^4 + 6 x^5`` (and out, when it
 stops), so the tank starts at rest and never jerks. Every channel gets white noise, a tone
 (a motor or electrical line at its own phase per channel) and a linear drift of the
-transducer's offset; forces and torques each at a fraction of the largest RMS of their kind
-(a quiet transverse channel is as noisy as the driven one, as on a real transducer), and
-optionally quantised. The motion is recorded with white noise (m, rad) on each axis.
+transducer's offset; forces and torques each at a fraction of the largest swing of their
+kind (a quiet transverse channel is as noisy as the driven one, as on a real transducer),
+and optionally quantised. The motion is recorded with white noise (m, rad) on each axis.
 """
 
 from __future__ import annotations
@@ -327,8 +327,9 @@ class Transducer:
 @dataclass(frozen=True)
 class Noise:
     """What acquisition adds. ``force`` and ``torque``: white noise as fractions of the
-    largest RMS of the force and of the torque channels; ``tone``: ``(fraction, Hz)``, a
-    line of that fraction of the same RMS on every channel (its own phase each); ``drift``:
+    largest standard deviation (the swing about the mean) of the force and of the torque
+    channels; ``tone``: ``(fraction, Hz)``, a line of that fraction of the same scale on
+    every channel (its own phase each); ``drift``:
     the offset drifts linearly from 0 to that fraction (sign drawn per channel);
     ``quantum``: ``(N, N m)`` steps of the recorded values (``None``: none); ``motion``:
     ``(m, rad)`` white noise on the recorded translations and angles."""
@@ -479,8 +480,10 @@ def simulate_motion(t, motion: Motion, *, pendulum: SphericalPendulum | None = N
                  "motion_clean": {a: motion.axis(a, t) for a in AXES}}
     rng = np.random.default_rng(seed)
     nz = noise or Noise(0.0, 0.0, None, 0.0, None, (0.0, 0.0))
-    scale = {"force": max(np.sqrt(np.mean(clean[c] ** 2)) for c in CHANNELS[:3]),
-             "torque": max(np.sqrt(np.mean(clean[c] ** 2)) for c in CHANNELS[3:])}
+    # the scale of each kind is the largest swing about its mean (the weight in force_z and
+    # its moment are no signal of a moving tank)
+    scale = {"force": max(np.std(clean[c]) for c in CHANNELS[:3]),
+             "torque": max(np.std(clean[c]) for c in CHANNELS[3:])}
     ramp = (t - t[0]) / (t[-1] - t[0])
     for c in CHANNELS:
         kind = c.split("_")[0]

@@ -408,6 +408,12 @@ def read_tables(ck: Checker, doc: Mapping[str, Any]):
     tank = _read_tank(ck, doc)
     liquid = _read_liquid(ck, doc)
     rig = _read_rig(ck, doc, excitation, rig_kind)
+    from .motion import read_motion  # six-axis records of a tank moved in 3-D
+
+    motion_ok, motion, transducer = read_motion(ck, doc, rig_kind, excitation)
+    if rig is not None and motion is not None:
+        rig = replace(rig, motion=motion, transducer=transducer)
+    rig = rig if motion_ok else None
     limits = _read_limits(ck, doc)
     if rig is not None and limits is not None:
         rig = replace(rig, limits=limits)

@@ -10,6 +10,7 @@ from analogs import (
     HingeSpring,
     LateralRig,
     Model,
+    MotionRig,
     Pendulum,
     QuadraticDamper,
     Rotor,
@@ -22,7 +23,8 @@ from analogs.tank.prediction import MAX_MODES
 
 from .case import Case
 
-__all__ = ["BASELINE", "ROTOR_AXIS", "model_for_case", "model_from_spec", "rig_for", "rig_values"]
+__all__ = ["BASELINE", "ROTOR_AXIS", "model_for_case", "model_from_spec", "rig_for", "rig_values",
+           "sees_transverse"]
 
 #: Tank axis of rotor analogs on the spinning rig: ``T.y``, the tangential direction (the
 #: way the tank origin moves), about which the nutation drives a rotor (the spin-axis
@@ -37,6 +39,7 @@ _MODIFIERS = {
     "nospring": "pendulum without hinge spring",
     "quadratic": "adds a QuadraticDamper",
     "diaphragm": "adds a DiaphragmSpring",
+    "spherical": "a SphericalPendulum: slosh along both tank axes (swirl)",
 }
 
 
@@ -52,7 +55,27 @@ def rig_for(case: Case) -> Rig:
     if case.test.rig != "lateral":
         raise InputError(f"{case.path}: [test] rig = {case.test.rig!r} is not supported; "
                          "expected 'lateral' or 'spinning'")
+    if case.rig.motion is not None:  # a six-axis record of a tank moved in 3-D
+        return MotionRig(axes=case.rig.motion.axes)
     return LateralRig(excitation=case.test.excitation)
+
+
+#: A six-axis record's signs of motion out of the x-z plane: a pendulum on its rig is then
+#: spherical (it can swirl), else planar in x-z.
+_TRANSVERSE_AXES = ("y", "roll", "yaw")
+_TRANSVERSE_CHANNELS = ("force_y", "torque_x", "torque_z")
+
+
+def sees_transverse(case: Case) -> bool:
+    """Whether a six-axis record (``[rig.motion]``) moves the tank out of the x-z plane or
+    measures a channel that only motion out of it drives (``force_y``, ``torque_x``,
+    ``torque_z``): its pendulums are then :class:`~analogs.SphericalPendulum` (slosh along
+    both tank axes, swirl), else planar."""
+    motion = case.rig.motion
+    if motion is None:
+        return False
+    return bool(set(motion.axes) & set(_TRANSVERSE_AXES)
+                or set(case.channels) & set(_TRANSVERSE_CHANNELS))
 
 
 def model_for_case(model: Model, case: Case) -> Model:
@@ -68,6 +91,16 @@ def model_for_case(model: Model, case: Case) -> Model:
                                          motion=spin.motion, name=rig.name,
                                          bounds={k: v for k, v in rig._bounds.items() if k in keep},
                                          **keep))
+    motion = case.rig.motion
+    if isinstance(rig, (LateralRig, MotionRig)) and motion is not None \
+            and getattr(rig, "axes", None) != motion.axes:
+        shared = {"dry_mass", "gravity"}  # a lateral model on a six-axis record's rig
+        if isinstance(rig, MotionRig):
+            shared |= {k for k in rig.parameters if k.startswith("transducer_")}
+        moved = MotionRig(axes=motion.axes, name=rig.name,
+                          bounds={k: v for k, v in rig._bounds.items() if k in shared},
+                          **{k: v for k, v in rig._values.items() if k in shared})
+        return Model(moved if c is rig else c for c in model.components)
     if isinstance(rig, LateralRig) and case.test.rig == "lateral" \
             and rig.excitation != case.test.excitation:
         shared = {"dry_mass", "gravity"}  # what both excitations of the rig have
@@ -79,7 +112,8 @@ def model_for_case(model: Model, case: Case) -> Model:
 
 
 def rig_values(case: Case) -> dict[str, float]:
-    """Parameter values the case file fixes: dry mass (when weighed), gravity and the crank geometry, or
+    """Parameter values the case file fixes: dry mass (when weighed), gravity and the crank
+    geometry (a six-axis record: the transducer's point and turn, ``[rig.transducer]``), or
     the spinning rig's geometry and constant motion (``[rig.spin]`` -> ``rig.radius``,
     ``rig.height`` and, without measured motion or schedules, ``rig.spin_rate``,
     ``rig.nutation_angle``, ``rig.nutation_frequency``)."""
@@ -96,6 +130,12 @@ def rig_values(case: Case) -> dict[str, float]:
     out = {"rig.gravity": case.rig.gravity}
     if case.rig.dry_mass is not None:  # else the container is not weighed: estimated
         out["rig.dry_mass"] = case.rig.dry_mass
+    if case.rig.motion is not None:  # where the six-axis transducer measures
+        from .case import Transducer
+
+        tr = case.rig.transducer or Transducer()
+        out |= {f"rig.transducer_{k}": getattr(tr, k)
+                for k in ("x", "y", "z", "roll", "pitch", "yaw")}
     if case.test.excitation == "crank" and case.crank is not None:
         out |= {"rig.crank_radius": case.crank.radius, "rig.rod_length": case.crank.rod_length,
                 "rig.drive_frequency": case.crank.frequency}
@@ -105,8 +145,8 @@ def rig_values(case: Case) -> dict[str, float]:
 def _tokens_text(spinning: bool) -> str:
     rotor = "; `rotor` or `rN` (rotor, spinning rig)" if spinning else ""
     return (f"valid tokens: `fixed`; `p1` to `p{MAX_MODES}` (pendulum of slosh mode N, the "
-            "modes the tank prediction gives), optionally with modifiers `:nospring`, "
-            f"`:quadratic`, `:diaphragm`{rotor}; e.g. `fixed,p1,p2:quadratic`")
+            "modes the tank prediction gives), optionally with modifiers "
+            + ", ".join(f"`:{m}`" for m in _MODIFIERS) + f"{rotor}; e.g. `fixed,p1,p2:quadratic`")
 
 
 def _number_of(name: str, letter: str) -> int | None:
@@ -122,9 +162,11 @@ def model_from_spec(spec: str, case: Case, *, option: str = "--model") -> Model:
 
     Tokens: ``fixed`` (FixedMass); ``pN`` with N from 1 to ``MAX_MODES`` (6: the modes the
     tank prediction gives initial values for) (Pendulum with HingeSpring and HingeDamper;
-    on the spinning rig a SphericalPendulum), optionally with modifiers after colons:
+    a SphericalPendulum on the spinning rig and on a six-axis record that sees motion out of
+    the x-z plane, :func:`sees_transverse`), optionally with modifiers after colons:
     ``pN:nospring`` (no hinge spring), ``pN:quadratic`` (adds a QuadraticDamper),
-    ``pN:diaphragm`` (adds a DiaphragmSpring); spinning rig only: ``rotor`` or ``rN``
+    ``pN:diaphragm`` (adds a DiaphragmSpring), ``pN:spherical`` (a SphericalPendulum: the
+    liquid may swirl); spinning rig only: ``rotor`` or ``rN``
     (a Rotor about the tangential tank axis :data:`ROTOR_AXIS`, coupled by a viscous damper).
     Errors name the option (``option``: ``--model``, or the file and key the specification
     came from) and list the valid tokens.
@@ -164,7 +206,8 @@ def model_from_spec(spec: str, case: Case, *, option: str = "--model") -> Model:
             else:
                 model = model + Rotor(name, axis=ROTOR_AXIS)
         elif pendulum is not None and 1 <= pendulum <= MAX_MODES:
-            pend = SphericalPendulum(name) if spinning else Pendulum(name)
+            spherical = spinning or "spherical" in mods or sees_transverse(case)
+            pend = SphericalPendulum(name) if spherical else Pendulum(name)
             model = model + pend + HingeDamper(name)
             if "nospring" not in mods:
                 model = model + HingeSpring(name)

@@ -182,8 +182,12 @@ class FitProblem:
         if input not in INPUT_MODES:
             raise InputError(f"input must be one of {', '.join(map(repr, INPUT_MODES))}, "
                              f"got {input!r}")
+        six_axis = all(c.motion is not None for c in cases)
         if force_cutoff_hz == "auto":
-            force_cutoff_hz = None if input == "estimated" else FILTERED_FORCE_CUTOFF_HZ
+            # six-axis records: the channels unfiltered (a 10 Hz filter cut the harmonics
+            # of 0.6 rad swings and biased the masses by 1.7 %; see estimate.data.motion)
+            force_cutoff_hz = None if input == "estimated" or six_axis else \
+                FILTERED_FORCE_CUTOFF_HZ
         cw = dict(channel_weights or {})
         bad = {k: v for k, v in cw.items()
                if isinstance(v, bool) or not isinstance(v, (int, float)) or not v > 0
@@ -197,6 +201,10 @@ class FitProblem:
         exps = tuple(experiment(c, model_for_case(model, c)) for c in cases)
         measurement = _resolve_channels(tuple(measurement), exps)
         w = tuple(weights) if weights is not None else tuple(None for _ in exps)
+        if weights is None:  # six-axis records: the force filter's ends left out
+            from ..data.motion import edge_weights
+
+            w = tuple(edge_weights(e.case, force_cutoff_hz) for e in exps)
         if len(w) != len(exps):
             raise InputError(f"weights: expected one entry per case ({len(exps)}), got {len(w)}")
         if lag not in LAG_MODES:
@@ -219,8 +227,15 @@ class FitProblem:
                            f"{', '.join(f'`{u}`' for u in unknown)}; the model's parameters are "
                            + ", ".join(params))
         rig_fixed = set().union(*(e.fixed for e in exps))
-        needed = list(dict.fromkeys(n for e in exps for n in e.derived.needed_parameters()))
+        # what the equations and the channels each case measures depend on (a six-axis
+        # record may measure a subset of its rig's channels)
+        needed = list(dict.fromkeys(n for e in exps
+                                    for n in e.derived.needed_parameters(e.channels or None)))
         notes = [n for c in cases for n in c.notes]  # what loading did to the records
+        if any(c.motion is not None for c in cases):
+            from ..data.motion import input_note
+
+            notes.append(input_note(input, force_cutoff_hz))
         if estimate is None:
             names = [n for n in needed if n not in rig_fixed and n not in hold]
             names += [n for mm in measurement for n in mm.parameters if n not in hold]
@@ -272,6 +287,10 @@ class FitProblem:
                 f"no initial value for {', '.join(f'`{n}`' for n in missing)}: {why}; give them "
                 f"with `initial` (e.g. `FitProblem.build(..., initial={{'{missing[0]}': ...}})`)")
         notes += source_notes(sources, [n for n in names if n not in given])
+        if any(c.motion is not None for c in cases):  # heights and inertias: data or tank?
+            from ..data.motion import moments_note
+
+            notes += [n for n in (moments_note(model, names, start),) if n]
         g = cases[0].rig.gravity
         inside = tank_ranges(cases[0], model, names, {
             n: length_bounds(v)[1] for n, v in predicted.items() if n.endswith(".length")})
