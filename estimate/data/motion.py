@@ -335,8 +335,9 @@ def moments_note(model, estimated: Sequence[str], values: Mapping[str, float]) -
     if kept:
         parts.append(", ".join(
             f"`{p.name}` = {values[p.name]:.4g} {p.unit}" if p.name in values else f"`{p.name}`"
-            for p in kept) + " enter none of its channels: kept from the tank module (or "
-                             "as given), not determined by the data")
+            for p in kept) + (" enters" if len(kept) == 1 else " enter")
+            + " none of its channels: kept from the tank module (or as given), not determined "
+              "by the data")
     return "six-axis record: " + "; ".join(parts)
 
 

@@ -118,4 +118,4 @@ def test_a_force_only_lateral_record_says_the_heights_are_not_its_own(tmp_path):
     prob = FitProblem.build(case, model_from_spec("fixed,p1:nospring", case))
     assert "p1.hinge_height" not in prob.names and "fixed.height" not in prob.names
     note = next(n for n in prob.notes if n.startswith("six-axis record: `fixed.height`"))
-    assert "enter none of its channels: kept from the tank module" in note
+    assert "enter none of its channels: kept from the tank module" in note, note
