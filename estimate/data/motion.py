@@ -390,9 +390,10 @@ def sign_problems(case: Case, *, frequency_hz: float | None = None,
     :data:`_SIGN_MIN_ACCELERATION` or more, :func:`rig_specific_force` ``s``), the low-passed
     force is fitted by least squares as ``M s + m b + c0 + c1 t``, with ``b`` the response of
     a linear slosh mode to ``s`` (``B/A = (2 zeta w s + w^2)/(s^2 + 2 zeta w s + w^2)``, its
-    frequency searched on a grid around ``frequency_hz``, ``[prediction]``'s, or the
-    force spectrum's peak; ``scipy.signal`` discretises and filters it from rest) and an
-    offset and drift of the transducer. Where that model explains the channel
+    frequency and damping searched on a grid around ``frequency_hz``, ``[prediction]``'s,
+    or the force spectrum's peak; ``scipy.signal`` filters it from rest) and an
+    offset and drift of the transducer (the mode discretised by the bilinear transform at
+    four samples per period of the low-pass). Where that model explains the channel
     (:data:`SIGN_MIN_EXPLAINED`), the mass moving with the tank along it, ``M + m``, must be
     positive: a negative one is a transducer axis that points against the tank's (mounted
     turned, a cable swapped), named in the problem. The slosh term keeps a drive just above
@@ -425,16 +426,20 @@ def sign_problems(case: Case, *, frequency_hz: float | None = None,
                 continue
             f0 = peaks[0].frequency
         cutoff = min(max(4.0 * f0 * _SIGN_BAND[1], 4.0), 0.4 / dt)
-        Fl, sl = lowpass(t, F, cutoff_hz=cutoff), lowpass(t, s, cutoff_hz=cutoff)
+        # the reflected ends suffice for a sign (the end model costs a search per channel)
+        Fl = lowpass(t, F, cutoff_hz=cutoff, ends="odd")
+        sl = lowpass(t, s, cutoff_hz=cutoff, ends="odd")
+        step = max(int(1.0 / (4.0 * cutoff * dt)), 1)  # four samples per cutoff period
+        tk, Fl, sl = t[::step], Fl[::step], sl[::step]
         ds = sl - sl[0]
         best = None
         for f in f0 * np.geomspace(*_SIGN_BAND, _SIGN_GRID):
             for zeta in _SIGN_ZETAS:
                 w = 2 * math.pi * f
-                num, den, _ = signal.cont2discrete(
-                    ([2 * zeta * w, w * w], [1, 2 * zeta * w, w * w]), dt, method="foh")
-                b = signal.lfilter(np.ravel(num), np.ravel(den), ds)
-                X = np.column_stack([ds, b, np.ones_like(t), t - t[0]])
+                num, den = signal.bilinear([2 * zeta * w, w * w], [1, 2 * zeta * w, w * w],
+                                           fs=1.0 / (step * dt))
+                b = signal.lfilter(num, den, ds)
+                X = np.column_stack([ds, b, np.ones_like(tk), tk - tk[0]])
                 coef, *_ = np.linalg.lstsq(X, Fl, rcond=None)
                 r = Fl - X @ coef
                 cost = float(r @ r)
@@ -446,7 +451,7 @@ def sign_problems(case: Case, *, frequency_hz: float | None = None,
         # both masses negative, each by several of its standard errors (the residual's
         # variance, inflated by the low-pass's correlation): a flipped axis, not a
         # resonance the linear mode reads poorly
-        cov = cost / max(t.size - 4, 1) * np.linalg.pinv(X.T @ X) * (0.5 / (cutoff * dt))
+        cov = cost / max(tk.size - 4, 1) * np.linalg.pinv(X.T @ X) * (0.5 / (cutoff * step * dt))
         se = np.sqrt(np.clip(np.diag(cov)[:2], 0.0, None))
         flipped = all(coef[k] < -_SIGN_SIGMAS * se[k] for k in (0, 1))
         mass = float(coef[0] + coef[1])
