@@ -104,7 +104,7 @@ def experiment(case: Case, model: Model) -> Experiment:
     constant rates (explicit functions of time) need none.
     """
     dm = derive(model)
-    if case.motion is not None:  # a six-axis record: every measured axis filtered alike
+    if getattr(case, "motion", None) is not None:  # six-axis: every measured axis filtered alike
         from .motion import motion_excitation
 
         def exc() -> Excitation | None:

@@ -55,9 +55,16 @@ def rig_for(case: Case) -> Rig:
     if case.test.rig != "lateral":
         raise InputError(f"{case.path}: [test] rig = {case.test.rig!r} is not supported; "
                          "expected 'lateral' or 'spinning'")
-    if case.rig.motion is not None:  # a six-axis record of a tank moved in 3-D
-        return MotionRig(axes=case.rig.motion.axes)
+    motion = _motion_of(case)
+    if motion is not None:  # a six-axis record of a tank moved in 3-D
+        return MotionRig(axes=motion.axes)
     return LateralRig(excitation=case.test.excitation)
+
+
+def _motion_of(case) -> object | None:
+    """The case's ``[rig.motion]`` (``None`` also for the stand-in cases that commands build
+    to name a rig: they carry no six-axis motion)."""
+    return getattr(getattr(case, "rig", None), "motion", None)
 
 
 #: A six-axis record's signs of motion out of the x-z plane: a pendulum on its rig is then
@@ -71,7 +78,7 @@ def sees_transverse(case: Case) -> bool:
     measures a channel that only motion out of it drives (``force_y``, ``torque_x``,
     ``torque_z``): its pendulums are then :class:`~analogs.SphericalPendulum` (slosh along
     both tank axes, swirl), else planar."""
-    motion = case.rig.motion
+    motion = _motion_of(case)
     if motion is None:
         return False
     return bool(set(motion.axes) & set(_TRANSVERSE_AXES)
@@ -91,7 +98,7 @@ def model_for_case(model: Model, case: Case) -> Model:
                                          motion=spin.motion, name=rig.name,
                                          bounds={k: v for k, v in rig._bounds.items() if k in keep},
                                          **keep))
-    motion = case.rig.motion
+    motion = _motion_of(case)
     if isinstance(rig, (LateralRig, MotionRig)) and motion is not None \
             and getattr(rig, "axes", None) != motion.axes:
         shared = {"dry_mass", "gravity"}  # a lateral model on a six-axis record's rig
@@ -130,7 +137,7 @@ def rig_values(case: Case) -> dict[str, float]:
     out = {"rig.gravity": case.rig.gravity}
     if case.rig.dry_mass is not None:  # else the container is not weighed: estimated
         out["rig.dry_mass"] = case.rig.dry_mass
-    if case.rig.motion is not None:  # where the six-axis transducer measures
+    if _motion_of(case) is not None:  # where the six-axis transducer measures
         from .case import Transducer
 
         tr = case.rig.transducer or Transducer()
