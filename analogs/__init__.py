@@ -14,6 +14,7 @@ from .fixed_mass import FixedMass
 from .hinge import DiaphragmSpring, HingeDamper, HingeSpring, QuadraticDamper, SwingDamper
 from .hinge_nonlinear import CubicHingeSpring, HingeFriction, HingeTorqueTerms
 from .model import Model, ModelError
+from .motion_rig import MotionRig
 from .mounted import Mounted
 from .parameter import Param, Parameter
 from .pendulum import Pendulum, SphericalPendulum
@@ -41,6 +42,7 @@ __all__ = [
     "LateralRig",
     "Model",
     "ModelError",
+    "MotionRig",
     "Mounted",
     "Param",
     "Parameter",

@@ -149,6 +149,13 @@ class FrameDeclaration(_Base):
     def gravity(self, value: me.Vector) -> None:
         self._shared.gravity = value
 
+    def set_transducer(self, point: me.Vector, frame: me.ReferenceFrame) -> None:
+        """Where the transducer measures: its reference ``point`` (m, a vector from the tank
+        origin, the point its torques are about) and its axes ``frame`` (oriented from
+        :attr:`tank`); the outputs ``force_*`` and ``torque_*`` are then components in
+        ``frame``. Without this call they are tank-frame components, torques about ``O``."""
+        self._shared.transducer = (point, frame)
+
     def add_input(self, local: str, unit: str, *, derivatives: int = 2,
                   derivative_of: sp.Function | None = None) -> sp.Function:
         """Declare a prescribed signal (a function of time) that the excitation supplies.
@@ -219,3 +226,6 @@ class Frames:
     origin_position: me.Vector
     gravity: me.Vector
     inputs: list[tuple[sp.Expr, str, str, int]] = field(default_factory=list)
+    #: ``(reference point, axes)`` of the transducer (:meth:`FrameDeclaration.set_transducer`);
+    #: ``None``: the tank origin and the tank axes.
+    transducer: tuple[me.Vector, me.ReferenceFrame] | None = None

@@ -5,9 +5,11 @@ a model (:func:`spec_of`, :meth:`analogs.Model.spec`).
 Tokens, comma-separated (``+`` works as a comma): ``fixed`` (:class:`FixedMass`); ``pN``
 with N from 1 to :data:`analogs.tank.prediction.MAX_MODES` (the modes the tank prediction
 gives initial values for): a :class:`Pendulum` (a :class:`SphericalPendulum` on the
-spinning rig) with :class:`HingeSpring` and :class:`HingeDamper`, optionally with modifiers
-after colons (:data:`MODIFIERS`); on a rig that rotates, ``rotor`` or ``rN``: a
-:class:`Rotor` about the tangential tank axis :data:`ROTOR_AXIS`.
+spinning rig, with the ``spherical`` modifier, or where the caller asks for one: a six-axis
+record that moves the tank out of the x-z plane) with :class:`HingeSpring` and
+:class:`HingeDamper`, optionally with modifiers after colons (:data:`MODIFIERS`); on a rig
+that rotates, ``rotor`` or ``rN``: a :class:`Rotor` about the tangential tank axis
+:data:`ROTOR_AXIS`.
 """
 
 from __future__ import annotations
@@ -33,6 +35,7 @@ MODIFIERS = {
     "nospring": "pendulum without hinge spring",
     "quadratic": "adds a QuadraticDamper",
     "diaphragm": "adds a DiaphragmSpring",
+    "spherical": "a SphericalPendulum: slosh along both tank axes (swirl)",
 }
 
 #: Attachments a ``pN`` token may carry, by modifier (None: always there).
@@ -49,8 +52,8 @@ def _max_modes() -> int:
 def _tokens_text(spinning: bool) -> str:
     rotor = "; `rotor` or `rN` (rotor, spinning rig)" if spinning else ""
     return (f"valid tokens: `fixed`; `p1` to `p{_max_modes()}` (pendulum of slosh mode N, the "
-            "modes the tank prediction gives), optionally with modifiers `:nospring`, "
-            f"`:quadratic`, `:diaphragm`{rotor}; e.g. `fixed,p1,p2:quadratic`")
+            "modes the tank prediction gives), optionally with modifiers "
+            + ", ".join(f"`:{m}`" for m in MODIFIERS) + f"{rotor}; e.g. `fixed,p1,p2:quadratic`")
 
 
 def _number_of(name: str, letter: str) -> int | None:
@@ -65,8 +68,9 @@ def _tokens(spec: str) -> list[str]:
     return [tok.strip() for tok in spec.replace("+", ",").split(",") if tok.strip()]
 
 
-def _build(spec: str, rig: Rig) -> tuple[Model, list[str]]:
-    """The model of ``spec`` on ``rig`` and every problem of the specification."""
+def _build(spec: str, rig: Rig, spherical: bool = False) -> tuple[Model, list[str]]:
+    """The model of ``spec`` on ``rig`` and every problem of the specification; every
+    pendulum a :class:`SphericalPendulum` when ``spherical`` (or on the spinning rig)."""
     model: Model = Model((rig,))
     spinning = isinstance(rig, SpinningRig)
     max_modes = _max_modes()
@@ -99,7 +103,8 @@ def _build(spec: str, rig: Rig) -> tuple[Model, list[str]]:
             else:
                 model = model + Rotor(name, axis=ROTOR_AXIS)
         elif pendulum is not None and 1 <= pendulum <= max_modes:
-            pend = SphericalPendulum(name) if spinning else Pendulum(name)
+            swirls = spinning or spherical or "spherical" in mods
+            pend = SphericalPendulum(name) if swirls else Pendulum(name)
             model = model + pend + HingeDamper(name)
             if "nospring" not in mods:
                 model = model + HingeSpring(name)
@@ -137,7 +142,8 @@ def _message(spec: str, rig: Rig, option: str, problems: list[str]) -> str:
             + _tokens_text(isinstance(rig, SpinningRig)))
 
 
-def model_from_spec(spec: str, rig: Rig, *, option: str = "--model") -> Model:
+def model_from_spec(spec: str, rig: Rig, *, option: str = "--model",
+                    spherical: bool = False) -> Model:
     """The model of the specification ``spec`` (module docstring) on ``rig``, validated;
     it knows its specification (:meth:`Model.spec` gives ``spec`` back, its tokens as
     given).
@@ -150,6 +156,12 @@ def model_from_spec(spec: str, rig: Rig, *, option: str = "--model") -> Model:
         The rig the components ride on.
     option : str, default "--model"
         Where the specification came from (an option, or a file and key): errors name it.
+    spherical : bool, default False
+        Every pendulum a :class:`SphericalPendulum`, as ``pN:spherical`` makes one: for a rig
+        whose record sees slosh out of the x-z plane (a six-axis record that moves the tank
+        along y, in roll or in yaw, or measures ``force_y``, ``torque_x`` or ``torque_z``;
+        :func:`estimate.data.models.sees_transverse`). The spinning rig's pendulums are
+        spherical anyway.
 
     Raises
     ------
@@ -162,7 +174,7 @@ def model_from_spec(spec: str, rig: Rig, *, option: str = "--model") -> Model:
     >>> model_from_spec("fixed,p1:quadratic", LateralRig()).spec()
     'fixed,p1:quadratic'
     """
-    model, problems = _build(spec, rig)
+    model, problems = _build(spec, rig, spherical)
     if problems:
         raise InputError(_message(spec, rig, option, problems))
     return Model(model.components, spec=",".join(_tokens(spec))).validate()
@@ -172,7 +184,7 @@ def spec_of(model: Model) -> str | None:
     """The specification :func:`model_from_spec` builds ``model`` from, read from its
     components (``"fixed,p1:nospring"``), or None when the model holds a component the
     grammar has no token for (a diagnosis's library term, a rig friction, a pendulum under
-    another name).
+    another name). A :class:`SphericalPendulum` off the spinning rig reads ``pN:spherical``.
 
     Parameters
     ----------
@@ -188,6 +200,8 @@ def spec_of(model: Model) -> str | None:
     """
     attached: dict[str, set[str | None]] = {}
     tokens: list[str] = []
+    swirling: dict[str, bool] = {}
+    spinning = any(isinstance(c, SpinningRig) for c in model.components)
     for c in model.components:
         if isinstance(c, Rig):
             continue
@@ -200,6 +214,7 @@ def spec_of(model: Model) -> str | None:
             tokens.append("fixed")
         elif type(c) in (Pendulum, SphericalPendulum) and _number_of(c.name, "p"):
             tokens.append(c.name)
+            swirling[c.name] = type(c) is SphericalPendulum
         elif type(c) is Rotor and (c.name == "rotor" or _number_of(c.name, "r")):
             tokens.append(c.name)
         else:
@@ -216,5 +231,7 @@ def spec_of(model: Model) -> str | None:
             return None
         mods = [] if "spring" in kinds else ["nospring"]
         mods += [m for m in ("quadratic", "diaphragm") if m in kinds]
+        if swirling.get(tok) and not spinning:  # the spinning rig's pendulums swirl anyway
+            mods.append("spherical")
         out.append(":".join([tok, *mods]))
     return ",".join(out) if out and not attached else None

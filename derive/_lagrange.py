@@ -143,9 +143,13 @@ def assemble(model: Model) -> SymbolicModel:
     def plain(e: sp.Expr) -> sp.Expr:
         return e.xreplace(rule)
 
+    axes = T
+    if shared.transducer is not None:  # measured about its point, in its own axes
+        point, axes = shared.transducer
+        torque = torque - point.cross(force)
     outputs = (
-        *[plain(c) for c in force.to_matrix(T)],
-        *[plain(c) for c in torque.to_matrix(T)],
+        *[plain(c) for c in force.to_matrix(axes)],
+        *[plain(c) for c in torque.to_matrix(axes)],
         plain(kinetic),
         plain(potential),
     )

@@ -47,7 +47,9 @@ class DerivedModel:
     - ``outputs`` -> ``y`` in :data:`OUTPUT_NAMES` order: the force (N) and torque about
       the tank origin (N m) that the transducer applies to the tank assembly, in tank-frame
       components (for a rigid tank, force = total mass x (acceleration - gravity)), then
-      kinetic and potential energy (J).
+      kinetic and potential energy (J); a rig that places its transducer
+      (:class:`analogs.MotionRig`) gives them in the transducer's axes, torques about its
+      reference point.
     - ``mass_matrix`` -> ``M(q, p)`` and ``forcing`` -> ``f(x, u, p, t)`` of
       ``M qdd = f``, kept apart (no symbolic inverse).
 

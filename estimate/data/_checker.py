@@ -1,6 +1,6 @@
 """The problem collector of a TOML document (:class:`Checker`: tables, keys, numbers
 with units, each problem naming the file and key) and the physical ranges of numbers
-(:func:`range_problem`)."""
+(:func:`range_problem`), and the TOML type a problem names (:func:`type_name`)."""
 
 from __future__ import annotations
 
@@ -10,7 +10,7 @@ from typing import Any
 
 from .case import PHYSICAL_RANGES
 
-__all__ = ["Checker", "range_problem"]
+__all__ = ["Checker", "range_problem", "type_name"]
 
 
 class Checker:
@@ -33,7 +33,7 @@ class Checker:
                 return None
             node = node[part]
         if not isinstance(node, Mapping):
-            self.add(f"[{name}]", f"expected a table, found {_type_name(node)} `{node!r}`")
+            self.add(f"[{name}]", f"expected a table, found {type_name(node)} `{node!r}`")
             return None
         return node
 
@@ -46,7 +46,7 @@ class Checker:
             return None
         value = table[key]
         if not isinstance(value, str):
-            self.add(where, f"expected a string, found {_type_name(value)} `{value!r}`")
+            self.add(where, f"expected a string, found {type_name(value)} `{value!r}`")
             return None
         if choices is not None and value not in choices:
             allowed = ", ".join(f'"{c}"' for c in choices)
@@ -61,7 +61,7 @@ class Checker:
             return None
         value = table[key]
         if not isinstance(value, bool):
-            self.add(where, f"expected true or false, found {_type_name(value)} `{value!r}`")
+            self.add(where, f"expected true or false, found {type_name(value)} `{value!r}`")
             return None
         return value
 
@@ -75,7 +75,7 @@ class Checker:
         value = table[key]
         # bool is an int subclass in Python; TOML true/false is never a valid number.
         if isinstance(value, bool) or not isinstance(value, (int, float)):
-            self.add(where, f"expected a number in {unit}, found {_type_name(value)} `{value!r}`")
+            self.add(where, f"expected a number in {unit}, found {type_name(value)} `{value!r}`")
             return None
         number = float(value)
         if not math.isfinite(number):
@@ -110,7 +110,8 @@ def range_problem(value: float, unit: str, *, positive: bool = False) -> str | N
     return None
 
 
-def _type_name(value: Any) -> str:
+def type_name(value: Any) -> str:
+    """How a problem names the TOML type of ``value`` (``"a string"``, ``"a table"``)."""
     names = {bool: "a boolean", int: "an integer", float: "a float", str: "a string",
              list: "an array", dict: "a table"}
     if isinstance(value, Mapping):

@@ -5,7 +5,7 @@ from __future__ import annotations
 import csv
 import io
 from collections import deque
-from collections.abc import Iterator
+from collections.abc import Iterator, Mapping
 from pathlib import Path
 from typing import Any
 
@@ -75,10 +75,12 @@ def _python_only(text: str) -> bool:
 
 
 def read_csv(path: Path, excitation: str | None, problems: list[str],
-              rig_kind: str | None = "lateral", *, uniform: bool = True
-              ) -> tuple[Any, ...] | None:
+              rig_kind: str | None = "lateral", *, uniform: bool = True,
+              motion: Mapping[str, str] | None = None) -> tuple[Any, ...] | None:
     """Read and check the CSV; append problems; return (time, displacement, force, columns)
-    or None (``columns``: the non-time columns of a spinning-rig CSV, else empty).
+    or None (``columns``: the non-time columns of a spinning-rig CSV or of a six-axis record,
+    else empty). ``motion``: the motion columns a six-axis record's ``[rig.motion]`` names
+    by axis (:mod:`estimate.data.motion`).
 
     The file is streamed: a record with more samples than the memory budget allows
     (:mod:`estimate.data.budget`) is refused before its arrays are allocated. A UTF-8 byte
@@ -94,7 +96,7 @@ def read_csv(path: Path, excitation: str | None, problems: list[str],
         with io.TextIOWrapper(open_input(path, "a CSV file"), newline="",
                               encoding="utf-8-sig") as fh:
             return _read_rows(csv.reader(fh), n_lines, name, excitation, problems, rig_kind,
-                              ended=ended, uniform=uniform)
+                              ended=ended, uniform=uniform, motion=motion)
     except InputError as exc:  # replaced by a pipe or a device since it was checked
         problems.append(f"{name}: {str(exc).split(': ', 1)[-1]}")
         return None
@@ -113,11 +115,12 @@ def _rows(reader) -> Iterator[tuple[int, list[str]]]:
 
 
 def _read_rows(reader, n_lines: int, name: str, excitation: str | None, problems: list[str],
-               rig_kind: str | None, *, ended: bool = True, uniform: bool = True
-               ) -> tuple[Any, ...] | None:
+               rig_kind: str | None, *, ended: bool = True, uniform: bool = True,
+               motion: Mapping[str, str] | None = None) -> tuple[Any, ...] | None:
     rows = _rows(reader)
     first = next(rows, None)
-    spinning = rig_kind == "spinning"
+    # a six-axis record reads like a spinning-rig one: named columns, all kept
+    spinning = rig_kind == "spinning" or motion is not None
     spin_header = "`" + ",".join(("time",) + SPINNING_CHANNELS) + "`"
     if first is None:
         expected = spin_header if spinning else "`time,displacement,force`"
@@ -126,7 +129,14 @@ def _read_rows(reader, n_lines: int, name: str, excitation: str | None, problems
     header_line, header = first
     names = tuple(c.strip() for c in header)
     has_disp = False
-    if spinning:
+    if motion is not None:
+        from .motion import motion_header_problems
+
+        header_problems = motion_header_problems(name, header_line, header, motion)
+        if header_problems:
+            problems.extend(header_problems)
+            return None
+    elif spinning:
         missing = [c for c in SPINNING_CHANNELS if c not in names]
         repeated = sorted({c for c in names if names.count(c) > 1})
         if not names or names[0] != "time" or missing or repeated:

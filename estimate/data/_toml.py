@@ -7,7 +7,7 @@ from collections.abc import Mapping
 from dataclasses import replace
 from typing import Any
 
-from ._checker import Checker, _type_name, range_problem
+from ._checker import Checker, range_problem, type_name
 from .case import (
     DRY_MASS_ESTIMATE,
     KNOWN_EXCITATIONS,
@@ -195,7 +195,7 @@ def _read_spin_motion(ck: Checker, t: Mapping[str, Any]) -> tuple[dict[str, Any]
             continue
         value = t[key]
         if not isinstance(value, str) or not value.strip():
-            found = f"{_type_name(value)} `{value!r}`" if not isinstance(value, str) \
+            found = f"{type_name(value)} `{value!r}`" if not isinstance(value, str) \
                 else 'an empty string ""'
             ck.add(f"[rig.spin] {key}", f"expected the name of a CSV column of measured rig "
                    f'motion (e.g. `{key} = "table_angle"`), found {found}; the nominal motion '
@@ -303,6 +303,12 @@ def read_tables(ck: Checker, doc: Mapping[str, Any]):
     tank = _read_tank(ck, doc)
     liquid = _read_liquid(ck, doc)
     rig = _read_rig(ck, doc, excitation, rig_kind)
+    from .motion import read_motion  # six-axis records of a tank moved in 3-D
+
+    motion_ok, motion, transducer = read_motion(ck, doc, rig_kind, excitation)
+    if rig is not None and motion is not None:
+        rig = replace(rig, motion=motion, transducer=transducer)
+    rig = rig if motion_ok else None
     limits = _read_limits(ck, doc)
     if rig is not None and limits is not None:
         rig = replace(rig, limits=limits)

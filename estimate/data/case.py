@@ -118,6 +118,38 @@ through them, truly irregular samples are interpolated); what was done is kept i
 gives the highest frequency of the carriage motion when the record cannot tell it (see
 :func:`estimate.data.signals.motion_band`); ``slosh fit --motion-band`` sets it too.
 
+Six-axis records of any tank motion
+-----------------------------------
+A lateral-rig case whose tank is moved and measured in 3-D (a carriage, shaker table,
+hexapod or robot arm carrying the tank on a six-axis force/torque transducer) names its
+motion columns in a ``[rig.motion]`` table; the case is then fitted on
+:class:`analogs.MotionRig`::
+
+    [rig.motion]                 # CSV columns of the measured motion (at least one)
+    x = "x"                      # m, the tank origin's travel along the lab x axis
+    y = "y"                      # m, along lab y
+    z = "z"                      # m, vertical
+    roll = "roll"                # rad, z-y-x attitude angles of the tank frame
+    pitch = "pitch"              # rad
+    yaw = "yaw"                  # rad
+
+    [rig.transducer]             # optional: where the transducer measures (default 0)
+    x = 0.0                      # m, its reference point in tank axes (torques about it)
+    y = 0.0
+    z = -0.05
+    roll = 0.0                   # rad, its axes turned from the tank axes (z-y-x)
+    pitch = 0.0
+    yaw = 3.141592653589793      # a transducer mounted turned by 180 deg about the tank axis
+
+Its CSV has ``time``, the motion columns and any non-empty subset of the six channels
+``force_x,force_y,force_z,torque_x,torque_y,torque_z`` (N, N m, in the transducer's axes), in
+any order; other columns are reported like unknown keys (a warning, an error under
+``--strict``). Each motion column is smoothed without phase lag and differentiated twice
+(:func:`estimate.data.signals.displacement_derivatives`), as the lateral carriage's
+displacement is. Loading checks, for each force channel along a translation, that the
+force has the sign of mass times acceleration during the large-motion part
+(:func:`estimate.data.motion_sign.sign_problems`).
+
 Validation limits
 -----------------
 * Time must increase strictly and be uniform: every step must be within
@@ -151,11 +183,13 @@ from .case_tables import (
     Crank,
     Limits,
     Liquid,
+    Motion,
     Prediction,
     Rig,
     Spin,
     Tank,
     TestInfo,
+    Transducer,
 )
 
 __all__ = [
@@ -174,6 +208,7 @@ __all__ = [
     "Crank",
     "Limits",
     "Liquid",
+    "Motion",
     "Prediction",
     "Rig",
     "SPINNING_CHANNELS",
@@ -182,6 +217,7 @@ __all__ = [
     "Spin",
     "Tank",
     "TestInfo",
+    "Transducer",
 ]
 
 KNOWN_RIGS: tuple[str, ...] = ("lateral", "spinning")
@@ -276,12 +312,14 @@ class Case:
     time : numpy.ndarray
         Sample times [s], strictly increasing and uniform.
     displacement : numpy.ndarray or None
-        Carriage displacement [m]; None when the CSV has no displacement column.
+        Carriage displacement [m]; None when the CSV has no displacement column (and for a
+        six-axis record, whose motion is in :attr:`columns`).
     force : numpy.ndarray or None
-        Measured lateral force [N] (lateral rig); None for the spinning rig.
+        Measured lateral force [N] (lateral rig); None for the spinning rig and a six-axis
+        record.
     columns : mapping of str to numpy.ndarray
-        The CSV columns besides ``time`` of a spinning-rig case (empty for a lateral case);
-        read them through :attr:`channels`.
+        The CSV columns besides ``time`` of a spinning-rig case or a six-axis record
+        (``[rig.motion]``; empty for a lateral case); read them through :attr:`channels`.
     notes : tuple of str
         What loading did to the record (e.g. the new time base of ``[test] resample_hz``);
         fit reports print them.
@@ -303,8 +341,10 @@ class Case:
     @property
     def channels(self) -> dict[str, NDArray[np.float64]]:
         """Measured signals by output name: ``{"force_x": force}`` for the lateral rig, the
-        six force/torque channels (and any extra CSV columns) for the spinning rig."""
-        if self.test.rig == "lateral":
+        six force/torque channels (and any extra CSV columns) for the spinning rig and for a
+        six-axis record of a tank moved in 3-D (``[rig.motion]``: the channels it has, its
+        motion columns and any other columns)."""
+        if self.test.rig == "lateral" and self.rig.motion is None:
             return {} if self.force is None else {"force_x": self.force}
         return dict(self.columns)
 
@@ -312,6 +352,11 @@ class Case:
     def spin(self) -> Spin | None:
         """The ``[rig.spin]`` table, or None."""
         return self.rig.spin
+
+    @property
+    def motion(self) -> Motion | None:
+        """The ``[rig.motion]`` table (a six-axis record of a tank moved in 3-D), or None."""
+        return self.rig.motion
 
     @property
     def crank(self) -> Crank | None:

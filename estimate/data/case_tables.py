@@ -1,14 +1,15 @@
 """The tables of a case file, one class each: ``[test]`` (:class:`TestInfo`), ``[tank]``
-(:class:`Tank`), ``[liquid]``, ``[rig.crank]``, ``[rig.spin]``, ``[rig.limits]``, ``[rig]`` and
-``[prediction]``, in SI units. :mod:`estimate.data.case` describes the file format and holds
-the :class:`~estimate.data.case.Case` they make up; :mod:`estimate.data.reader` reads them."""
+(:class:`Tank`), ``[liquid]``, ``[rig.crank]``, ``[rig.spin]``, ``[rig.limits]``,
+``[rig.motion]``, ``[rig.transducer]``, ``[rig]`` and ``[prediction]``, in SI units.
+:mod:`estimate.data.case` describes the file format and holds the
+:class:`~estimate.data.case.Case` they make up; :mod:`estimate.data.reader` reads them."""
 
 from __future__ import annotations
 
 from dataclasses import dataclass
 
 __all__ = ["LIMIT_UNITS", "SHAPE_KEYS", "SPIN_COLUMN_KEYS", "Crank", "Limits", "Liquid",
-           "Prediction", "Rig", "Spin", "Tank", "TestInfo"]
+           "Motion", "Prediction", "Rig", "Spin", "Tank", "TestInfo", "Transducer"]
 
 SPIN_COLUMN_KEYS: tuple[str, ...] = ("spin_angle", "spin_rate", "nutation_phase", "cone_angle")
 """Keys of ``[rig.spin]`` that name CSV columns of measured rig motion."""
@@ -245,6 +246,53 @@ class Spin:
         return self.spin_up if self.nutation_start is None else self.nutation_start
 
 
+@dataclass(frozen=True)
+class Motion:
+    """The ``[rig.motion]`` table: the CSV columns of the tank's measured motion
+    (:class:`analogs.MotionRig`), by axis; ``None`` for an axis that does not move.
+
+    Attributes
+    ----------
+    x, y, z : str or None
+        Columns of the tank origin's position along the lab axes [m].
+    roll, pitch, yaw : str or None
+        Columns of the tank frame's z-y-x attitude angles [rad].
+    """
+
+    x: str | None = None
+    y: str | None = None
+    z: str | None = None
+    roll: str | None = None
+    pitch: str | None = None
+    yaw: str | None = None
+
+    @property
+    def columns(self) -> dict[str, str]:
+        """CSV column by axis, in :data:`analogs.motion_rig.MOTION_AXES` order."""
+        from analogs.motion_rig import MOTION_AXES
+
+        return {a: getattr(self, a) for a in MOTION_AXES if getattr(self, a) is not None}
+
+    @property
+    def axes(self) -> tuple[str, ...]:
+        """The axes that are measured (the rig's inputs)."""
+        return tuple(self.columns)
+
+
+@dataclass(frozen=True)
+class Transducer:
+    """The optional ``[rig.transducer]`` table: the six-axis transducer's reference point
+    ``x, y, z`` [m, tank axes] and the turn of its axes from the tank axes ``roll, pitch,
+    yaw`` [rad, z-y-x]; every value defaults to 0 (the tank origin, the tank axes)."""
+
+    x: float = 0.0
+    y: float = 0.0
+    z: float = 0.0
+    roll: float = 0.0
+    pitch: float = 0.0
+    yaw: float = 0.0
+
+
 #: Keys of ``[rig.limits]`` with their units, in the order they are written.
 LIMIT_UNITS: dict[str, str] = {"stroke": "m", "velocity": "m/s", "acceleration": "m/s^2",
                                "duration": "s", "sample_rate": "Hz", "spin_rate": "rad/s",
@@ -299,6 +347,10 @@ class Rig:
         The ``[rig.spin]`` table (spinning rig only).
     limits : Limits or None
         The ``[rig.limits]`` table when present.
+    motion : Motion or None
+        The ``[rig.motion]`` table (a six-axis record of a tank moved in 3-D) when present.
+    transducer : Transducer or None
+        The ``[rig.transducer]`` table when present (only with ``motion``).
     """
 
     dry_mass: float | None
@@ -306,6 +358,8 @@ class Rig:
     crank: Crank | None = None
     spin: Spin | None = None
     limits: Limits | None = None
+    motion: Motion | None = None
+    transducer: Transducer | None = None
 
 
 @dataclass(frozen=True)

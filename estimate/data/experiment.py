@@ -99,12 +99,19 @@ def experiment(case: Case, model: Model) -> Experiment:
 
     A measured displacement becomes a zero-phase smoothed displacement, velocity and
     acceleration (:func:`estimate.data.signals.displacement_derivatives`) interpolated by
-    cubic B-splines; a spinning rig spun up or coned in drives its input signals from the
-    measured rig angles or schedules (:func:`estimate.data.spin.spin_excitation`); a crank
-    drive and a spinning rig at constant rates (explicit functions of time) need none.
+    cubic B-splines, and so does each measured axis of a six-axis record
+    (:func:`estimate.data.motion.motion_excitation`); a spinning rig spun up or coned in
+    drives its input signals from the measured rig angles or schedules
+    (:func:`estimate.data.spin.spin_excitation`); a crank drive and a spinning rig at
+    constant rates (explicit functions of time) need none.
     """
     dm = derive(model)
-    if case.test.rig == "lateral" and case.test.excitation == "measured":
+    if getattr(case, "motion", None) is not None:  # six-axis: every measured axis filtered alike
+        from .motion import motion_excitation
+
+        def exc() -> Excitation | None:
+            return motion_excitation(case)
+    elif case.test.rig == "lateral" and case.test.excitation == "measured":
         if case.displacement is None:
             raise InputError(f"{case.path}: excitation = 'measured' needs a displacement column")
 

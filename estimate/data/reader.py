@@ -99,6 +99,9 @@ def load_case(path: str | os.PathLike[str], *, strict: bool = False) -> Case:
     t_table = doc.get("test")
 
     problems = ck.problems
+    from .motion import extra_columns, motion_columns
+
+    motion = motion_columns(doc)  # a six-axis record's motion columns, by axis
     notes: list[str] = []
     unitless: dict[str, str] = {}  # lab-file columns read with no unit, and their channels
     arrays = None
@@ -124,11 +127,16 @@ def load_case(path: str | os.PathLike[str], *, strict: bool = False) -> Case:
         else:
             csv_problems: list[str] = []
             uniform = not (isinstance(t_table, Mapping) and "resample_hz" in t_table)
-            if lab:
+            if lab and motion is not None:
+                csv_problems.append(f"{fname}: [rig.motion]: a six-axis record is read from a "
+                                    f"CSV file (`time`, the motion columns, the channels); "
+                                    f"found {what} (export it to CSV)")
+            elif lab:
                 arrays = read_lab(data_path, fname, doc, excitation, rig_kind, rig, csv_problems,
                                   uniform=uniform, unitless=unitless)
             else:
-                arrays = read_csv(data_path, excitation, csv_problems, rig_kind, uniform=uniform)
+                arrays = read_csv(data_path, excitation, csv_problems, rig_kind, uniform=uniform,
+                                  motion=motion)
             problems.extend(csv_problems)
             if arrays is not None and test is not None and test.resample_hz is not None:
                 arrays, note = _uniform(data_path.name, arrays, test.resample_hz, problems)
@@ -139,6 +147,8 @@ def load_case(path: str | os.PathLike[str], *, strict: bool = False) -> Case:
                 problems.extend(spin_column_problems(fname, rig.spin, arrays[3], arrays[0]))
 
     unknown = unknown_keys(doc, fname, ignored=not strict)
+    if motion is not None and arrays is not None and data_path is not None:
+        unknown += extra_columns(data_path.name, list(arrays[3]), motion, ignored=not strict)
     if strict and unknown:
         raise CaseError(problems + unknown)
     if problems:  # a likely typo may explain a missing key
@@ -155,9 +165,16 @@ def load_case(path: str | os.PathLike[str], *, strict: bool = False) -> Case:
     for arr in (time, disp, force, *columns.values()):
         if arr is not None:
             arr.flags.writeable = False
-    return Case(path=toml_path.resolve(), data_path=data_path.resolve(), test=test, tank=tank,
+    case = Case(path=toml_path.resolve(), data_path=data_path.resolve(), test=test, tank=tank,
                 liquid=liquid, rig=rig, prediction=prediction, time=time, displacement=disp,
                 force=force, columns=columns, notes=tuple(n for n in notes if n))
+    if case.motion is not None:
+        from .motion_sign import sign_problems
+
+        flipped = sign_problems(case)
+        if flipped:
+            raise CaseError(flipped)
+    return case
 
 
 def _unit_warnings(name: str, unitless: dict[str, str], arrays: tuple, tank, liquid, rig

@@ -100,6 +100,15 @@ def _toml_text(test: TestInfo, tank: Tank, liquid: Liquid, rig: Rig,
                            ("height", sp.height, "m, tank origin above the nutation pivot"),
                            ("tank_axis", sp.tank_axis, ""),
                            ("gravity_on", sp.gravity_on, "")] + _spin_motion_rows(sp))
+    if rig.motion is not None:
+        units = {"x": "m", "y": "m", "z": "m", "roll": "rad", "pitch": "rad", "yaw": "rad"}
+        table("rig.motion", [(k, v, f"CSV column, {units[k]}") for k, v in rig.motion.columns.items()])
+    if rig.transducer is not None:
+        tr = rig.transducer
+        table("rig.transducer", [(k, getattr(tr, k), "m, reference point in tank axes")
+                                 for k in ("x", "y", "z")]
+              + [(k, getattr(tr, k), "rad, turn of its axes from the tank's (z-y-x)")
+                 for k in ("roll", "pitch", "yaw")])
     if rig.crank is not None:
         table("rig.crank", [("radius", rig.crank.radius, "m"),
                             ("rod_length", rig.crank.rod_length, "m"),
@@ -172,7 +181,9 @@ def write_case(path: str | os.PathLike[str], *, test: TestInfo, tank: Tank, liqu
         displacement.
     channels : mapping of str to array_like, optional
         Spinning rig (required there): the six channels of :data:`SPINNING_CHANNELS`
-        (N, N m) and any extra columns, written in this order after ``time``.
+        (N, N m) and any extra columns, written in this order after ``time``. A six-axis
+        record (``rig.motion`` set, required there): its motion columns and any subset of
+        the six channels.
     comment : str, optional
         Text written as ``#`` comment lines at the top of the TOML file.
     overwrite : bool, default False
@@ -214,10 +225,13 @@ def write_case(path: str | os.PathLike[str], *, test: TestInfo, tank: Tank, liqu
             raise FileExistsError(f"refusing to overwrite existing file(s) {', '.join(existing)}; "
                                   "pass `overwrite=True` to replace them")
     t = np.asarray(time, dtype=float)
-    if test.rig == "spinning":
+    if test.rig == "spinning" or rig.motion is not None:
         if channels is None or force is not None or displacement is not None:
-            raise ValueError("a spinning-rig case takes `channels` (time series of "
-                             + ", ".join(SPINNING_CHANNELS) + "), not `force` or `displacement`")
+            what = ("a spinning-rig case takes `channels` (time series of " if test.rig == "spinning"
+                    else "a six-axis record (`rig.motion`) takes `channels` (time series of its "
+                    "motion columns and any of ")
+            raise ValueError(what + ", ".join(SPINNING_CHANNELS) + "), not `force` or "
+                             "`displacement`")
         ch = {str(k): np.asarray(v, dtype=float) for k, v in channels.items()}
         bad = {k: v.shape for k, v in ch.items() if v.shape != t.shape}
         if t.ndim != 1 or bad:

@@ -30,7 +30,7 @@ from .starts import (
     spin_start,
     with_lag,
 )
-from .strategies import InputMode, StartPolicy, input_mode, start_policy
+from .strategies import InputMode, StartPolicy, input_mode, record_cutoff, start_policy
 
 __all__ = ["Arguments", "build_problem"]
 
@@ -77,7 +77,7 @@ def checked_arguments(cases: Case | Sequence[Case], *, hold, initial, bounds, fo
         problems.append(err)
     mode = None
     try:
-        mode = input_mode(input, force_cutoff_hz)
+        mode = input_mode(input, record_cutoff(cases, input, force_cutoff_hz))
     except InputError as err:
         problems.append(err)
     policy = None
@@ -92,7 +92,13 @@ def checked_arguments(cases: Case | Sequence[Case], *, hold, initial, bounds, fo
     if bad:
         problems.append(InputError("channel_weights: expected positive finite scales (N or N m), "
                                    "found " + ", ".join(f"`{k}` = {v!r}" for k, v in bad.items())))
-    w = tuple(weights) if weights is not None else tuple(None for _ in cases)
+    if weights is not None:
+        w = tuple(weights)
+    else:  # six-axis records low-passed: the force filter's ends left out
+        from ..data.motion import edge_weights
+
+        cutoff = mode.force_cutoff_hz if mode is not None else None
+        w = tuple(edge_weights(c, cutoff) for c in cases)
     if len(w) != len(cases):
         problems.append(InputError(f"weights: expected one entry per case ({len(cases)}), "
                                    f"got {len(w)}"))
@@ -158,12 +164,14 @@ def name_problems(args: Arguments, estimate: Sequence[str] | None, params: Mappi
 def estimated_names(estimate: Sequence[str] | None, args: Arguments,
                     exps: Sequence[Experiment], measurement: Sequence) -> tuple[list[str], list[str]]:
     """The parameters to estimate and notes: the user's, or every parameter the
-    equations and the measured outputs need less the rig values the case files fix, the
-    held ones and the masses a free decay cannot determine."""
+    equations and the outputs each case measures need (a six-axis record may measure a
+    subset of its rig's channels) less the rig values the case files fix, the held ones
+    and the masses a free decay cannot determine."""
     if estimate is not None:
         return list(estimate), []
     rig_fixed = set().union(*(e.fixed for e in exps))
-    needed = list(dict.fromkeys(n for e in exps for n in e.derived.needed_parameters()))
+    needed = list(dict.fromkeys(n for e in exps
+                                for n in e.derived.needed_parameters(e.channels or None)))
     names = [n for n in needed if n not in rig_fixed and n not in args.hold]
     names += [n for mm in measurement for n in mm.parameters if n not in args.hold]
     at_rest, rest_notes = rest_holds(exps, names)  # free decays: masses undetermined
@@ -314,10 +322,19 @@ def build_problem(cls, cases: Case | Sequence[Case], model: Model, *,
     params = model_parameters(exps, measurement)
     raise_all(name_problems(args, estimate, params, exps, measurement))
     notes = [n for c in cases for n in c.notes]  # what loading did to the records
+    six_axis = any(c.motion is not None for c in cases)
+    if six_axis:
+        from ..data.motion import input_note
+
+        notes.append(input_note(args.mode.name, args.mode.force_cutoff_hz))
     names, rest_notes = estimated_names(estimate, args, exps, measurement)
     notes += rest_notes
     st = starting_point(args, model, exps, params, names, stage, stage_note, lag_note, notes)
     names, start, predicted, tied, given = st.names, st.values, st.predicted, st.tied, st.given
+    if six_axis:  # heights and inertias: from the data or the tank?
+        from ..data.motion import moments_note
+
+        notes += [n for n in (moments_note(model, names, start),) if n]
     ties, linear, stage_start = st.ties, st.linear, st.stage_start
     g = cases[0].rig.gravity
     inside = tank_ranges(cases[0], model, names, {

@@ -24,7 +24,7 @@ from analogs.errors import InputError
 __all__ = ["AbsCost", "COSTS", "Cost", "DEFAULT_COST", "DEFAULT_INPUT", "DEFAULT_START",
            "EstimatedInput", "FILTERED_FORCE_CUTOFF_HZ", "FilteredInput", "FirstStageStart",
            "INPUT_MODES", "InputMode", "PredictionStart", "SquaredCost", "StartPolicy",
-           "cost_of", "input_mode", "start_policy"]
+           "cost_of", "input_mode", "record_cutoff", "start_policy"]
 
 #: Force low-pass of the filtered-input mode [Hz] (the seed's workflow).
 FILTERED_FORCE_CUTOFF_HZ = 10.0
@@ -111,6 +111,29 @@ def input_mode(value: InputMode | str | None = None,
                          "leave `force_cutoff_hz` at its default (no force filter), or use "
                          "input='filtered'")
     return mode
+
+
+def record_cutoff(cases, value: InputMode | str | None,
+                  force_cutoff_hz: float | None | str = "auto") -> float | None | str:
+    """The force low-pass ``force_cutoff_hz`` as the records call for it: six-axis records
+    (every case with ``[rig.motion]``, :mod:`estimate.data.motion`) fitted with the filtered
+    input named by its string (``value="filtered"``) keep their channels unfiltered (None):
+    a 10 Hz filter cut the harmonics of 0.6 rad swings and biased the masses by 1.7 %. A
+    cutoff given (not ``"auto"``) or a :class:`FilteredInput` object's own is kept.
+
+    Parameters
+    ----------
+    cases : sequence of Case
+        The records.
+    value : InputMode, str or None
+        The input mode as :func:`input_mode` takes it.
+    force_cutoff_hz : float, None or "auto", default "auto"
+        The force low-pass asked for [Hz].
+    """
+    six_axis = bool(cases) and all(getattr(c, "motion", None) is not None for c in cases)
+    if force_cutoff_hz == "auto" and six_axis and value == FilteredInput.name:
+        return None
+    return force_cutoff_hz
 
 
 class Cost:

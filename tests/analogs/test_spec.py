@@ -7,8 +7,10 @@ from analogs import (
     FixedMass,
     HingeDamper,
     LateralRig,
+    MotionRig,
     Pendulum,
     QuadraticDamper,
+    SphericalPendulum,
     SpinningRig,
     model_from_spec,
     spec_of,
@@ -36,6 +38,23 @@ def test_spec_read_from_components_when_not_built_from_one():
 def test_a_model_changed_after_its_spec_reads_its_components():
     model = model_from_spec("fixed,p1:quadratic", LateralRig())
     assert model.without("fixed").spec() == "p1:quadratic"
+
+
+def test_spherical_pendulums_off_the_spinning_rig():
+    """``pN:spherical`` (or ``spherical=True``, a six-axis record that sees out of the x-z
+    plane) makes a SphericalPendulum; read from the components it comes back as the
+    modifier, except on the spinning rig, whose pendulums swirl anyway."""
+    model = model_from_spec("fixed,p1:nospring:spherical", MotionRig(axes=("x", "y")))
+    assert type(model.components[2]) is SphericalPendulum
+    assert spec_of(model) == "fixed,p1:nospring:spherical"
+    assert model_from_spec(spec_of(model), MotionRig(axes=("x", "y"))).structure_key() \
+        == model.structure_key()
+    asked = model_from_spec("fixed,p1", LateralRig(), spherical=True)
+    assert type(asked.components[2]) is SphericalPendulum and asked.spec() == "fixed,p1"
+    assert spec_of(asked) == "fixed,p1:spherical"
+    assert spec_of(model_from_spec("fixed,p1", SpinningRig())) == "fixed,p1"
+    with pytest.raises(InputError, match="`:spherical`"):
+        model_from_spec("fixed,p1:swirl", LateralRig())
 
 
 def test_a_component_without_a_token_has_no_spec():
