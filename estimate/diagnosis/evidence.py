@@ -289,7 +289,37 @@ def _multichannel_evidence(result: FitResult, case: int) -> Evidence:
         rms_residual=float(np.sqrt(np.mean(r**2))), noise=noise_figure(result, case),
         drive_frequency=None, sweep=False, peaks=(), harmonics={}, ljung_box_q=q,
         ljung_box_p=pval, skew_correlation=0.0, skew_delay=0.0, frequency_ratio=None,
-        pinned=pinned, channel_share={c: float(p / total) for c, p in zip(chans, power)})
+        pinned=pinned, channel_share={c: float(p / total) for c, p in zip(chans, power)},
+        residual_frequencies=_channel_lines(t, np.where(keep[:, None], result.scaled_residuals(
+            case).reshape(t.size, -1), 0.0)))
+
+
+#: A spectral line of one channel's scaled residual counts where the residual concentrates
+#: when its amplitude is at least this fraction of that channel's RMS residual.
+LINE_SHARE = 0.3
+
+
+def _channel_lines(t: np.ndarray, r: np.ndarray) -> tuple[float, ...]:
+    """The frequencies (Hz) of the strongest spectral lines of a multi-channel scaled
+    residual ``r`` (samples x channels), at most three, strongest (summed over the channels
+    it is on, within 2 %) first."""
+    fs = 1.0 / float(np.median(np.diff(t)))
+    lines: list[list[float]] = []  # [frequency, summed squared amplitude]
+    for k in range(r.shape[1]):
+        rms = float(np.sqrt(np.mean(r[:, k] ** 2)))
+        if rms == 0.0:
+            continue
+        for pk in find_spectral_peaks(t, r[:, k], min_frequency=0.3, max_frequency=0.45 * fs,
+                                      min_relative_height=1e-2, max_peaks=4):
+            if pk.amplitude < LINE_SHARE * rms:
+                continue
+            same = next((ln for ln in lines if abs(ln[0] - pk.frequency) <= 0.02 * ln[0]), None)
+            if same is None:
+                lines.append([pk.frequency, pk.amplitude**2])
+            else:
+                same[1] += pk.amplitude**2
+    lines.sort(key=lambda ln: -ln[1])
+    return tuple(float(f) for f, _ in lines[:3])
 
 
 def segment_damping(result: FitResult, *, case: int = 0, n_segments: int = 4,
@@ -308,8 +338,9 @@ def segment_damping(result: FitResult, *, case: int = 0, n_segments: int = 4,
     problem = result.problem
     exp = problem.experiments[case]
     names = set(result.names)
-    if exp.case.test.rig != "lateral" or not {"p1.damping", "p1.length"} <= names:
-        return ()
+    if exp.case.test.rig != "lateral" or exp.case.force is None \
+            or not {"p1.damping", "p1.length"} <= names:
+        return ()  # the spinning rig's and six-axis records: their families read no trend
     values = problem.case_values(case, result.values)
     coords = exp.derived.coordinates
     theta = (result.states[case][coords.index("p1.theta")]

@@ -73,7 +73,9 @@ def baseline_model(case: Case) -> Model:
     what a diaphragm adds, so it is a candidate (``diaphragm_stiffness``), not part of the
     baseline. The pendulum length is anchored to the prediction (+/-20 %). On the spinning
     rig the pendulum is spherical (:class:`analogs.SphericalPendulum`) on the rig of
-    :func:`estimate.data.models.rig_for`.
+    :func:`estimate.data.models.rig_for`; on a six-axis record too when its drive is not
+    planar (:data:`~.families.swirl.PLANAR_DRIVE`), else planar: liquid that moves across
+    a planar drive is swirl, a candidate (:mod:`.families.swirl`).
     """
     if case.test.rig == "spinning":
         from analogs import SphericalPendulum
@@ -82,7 +84,14 @@ def baseline_model(case: Case) -> Model:
 
         return (Model((rig_for(case),)) + FixedMass("fixed") + SphericalPendulum("p1")
                 + HingeDamper("p1"))
-    return (LateralRig(excitation=case.test.excitation) + FixedMass("fixed") + Pendulum("p1")
+    from .families.swirl import PLANAR_DRIVE, transverse_drive
+
+    pendulum = Pendulum("p1")
+    if transverse_drive(case) > PLANAR_DRIVE:
+        from analogs import SphericalPendulum
+
+        pendulum = SphericalPendulum("p1")
+    return (LateralRig(excitation=case.test.excitation) + FixedMass("fixed") + pendulum
             + HingeDamper("p1"))
 
 
@@ -221,7 +230,7 @@ def _proposals(ctx: Context) -> tuple[list[Proposal], list[CandidateOutcome], Pr
     fams = [f for f in FAMILIES if f.applies(ctx)]
     terms = {f.cause: f.terms(ctx) for f in fams}
     scores: list[Score] = []
-    if any(terms.values()) or (ctx.lateral and ctx.single_channel):
+    if any(terms.values()) or (ctx.lateral and ctx.single_channel and not ctx.six_axis):
         ctx.linearisation, ctx.base_names, scores = screen(
             ctx.current, [t for ts in terms.values() for t in ts],
             build=lambda m, mm, init: ctx.fitter.problem(m, mm, init))

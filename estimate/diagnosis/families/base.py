@@ -129,6 +129,13 @@ class Context:
         return all(len(e.channels) == 1 for e in self.current.problem.experiments)
 
     @property
+    def six_axis(self) -> bool:
+        """Whether the records are six-axis records of a tank moved in 3-D
+        (``[rig.motion]``: fitted on :class:`~analogs.MotionRig`)."""
+        return all(getattr(e.case, "motion", None) is not None
+                   for e in self.current.problem.experiments)
+
+    @property
     def inertia(self) -> float | None:
         """The predicted first mode's hinge inertia m L^2 (kg m^2), or ``None``."""
         i = self.predicted.get("p1.mass", math.nan) * self.predicted.get("p1.length", math.nan) ** 2
@@ -152,7 +159,8 @@ class Context:
 class Family:
     """A diagnosis family (subclass it, one module each). Class attributes: ``cause`` (the
     name a finding carries), ``rig`` (``"lateral"``: single-channel lateral records;
-    ``"spinning"``: six-channel spinning-rig records), ``library`` (a term of the
+    ``"spinning"``: six-channel spinning-rig records; ``"motion"``: six-axis records of a
+    tank moved in 3-D), ``library`` (a term of the
     hinge-torque library, fitted only when no named family explains the residual). A
     family's docstring is its :attr:`description`: the physical effect and what it adds."""
 
@@ -166,9 +174,17 @@ class Family:
         cls.description = " ".join((cls.__doc__ or "").split())
 
     def applies(self, ctx: Context) -> bool:
-        """Whether the family can describe this kind of record."""
-        lateral = ctx.lateral and ctx.single_channel
-        return lateral if self.rig == "lateral" else not ctx.single_channel
+        """Whether the family can describe this kind of record: single-channel lateral
+        records of the lateral carriage, the spinning rig's, or six-axis records of a tank
+        moved in 3-D (``"motion"``: a :class:`~analogs.MotionRig` case, any channels; the
+        lateral families' scans and screening drive the model along x alone)."""
+        from analogs import SpinningRig
+
+        if self.rig == "lateral":
+            return ctx.lateral and ctx.single_channel and not ctx.six_axis
+        if self.rig == "spinning":
+            return isinstance(ctx.model.rig, SpinningRig)
+        return ctx.six_axis
 
     def terms(self, ctx: Context) -> tuple[Term, ...]:
         """The additions the round's screening scores at their null values (none: the

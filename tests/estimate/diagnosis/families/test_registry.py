@@ -21,7 +21,7 @@ def test_every_family_module_is_registered_once_with_a_description():
     for fam in FAMILIES:
         assert family(fam.cause) is fam
         assert len(fam.description) > 40, fam.cause
-        assert fam.rig in ("lateral", "spinning")
+        assert fam.rig in ("lateral", "spinning", "motion")
 
 
 def test_the_readme_documents_exactly_the_registered_causes():
