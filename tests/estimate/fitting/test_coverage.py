@@ -88,6 +88,7 @@ def test_robust_intervals_cover_the_truth_on_a_transducer_record(tmp_path):
             robust[k] += lo <= truth[k] <= hi
             i = res.names.index(k)
             gauss_newton[k] += abs(res.values[i] - truth[k]) <= 1.96 * gn[i]
+    print(f"\nrobust {robust}\nGauss-Newton {gauss_newton}")  # the counts, with -s
     assert all(h >= 90 for h in robust.values()), robust
     assert all(gauss_newton[k] < robust[k] for k in names), (gauss_newton, robust)
 
@@ -111,5 +112,6 @@ def test_robust_intervals_cover_the_first_mode_when_a_second_is_missing(tmp_path
             lo, hi = res.interval(k)
             robust[k] += lo <= truth[k] <= hi
         flagged += bool(set(names) & set(res.optimistic())) and "optimistic" in res.report()
+    print(f"\nrobust {robust}, flagged optimistic {flagged}")  # the counts, with -s
     assert all(h >= 85 for h in robust.values()), robust
     assert flagged >= 85, flagged
