@@ -22,14 +22,26 @@ PEND = rs.SphericalPendulum(1.25, 0.062, 0.035, damping=0.0005)
 ROTOR = rs.Rotor(0.01, 0.04, axis="y")
 
 
-@pytest.fixture(scope="module")
-def spinning_case(tmp_path_factory):
+def _spinning_case(tmp_path_factory, duration: float):
     folder = tmp_path_factory.mktemp("spin")
     case, _ = make_spinning_case(folder, "S1", RIG, pendulum=PEND, rotor=ROTOR, fixed_mass=1.5,
-                                 noise=0.01, seed=3, tank_radius=0.1016, duration=20.0)
+                                 noise=0.01, seed=3, tank_radius=0.1016, duration=duration)
     return case
 
 
+@pytest.fixture(scope="module")
+def spinning_case(tmp_path_factory):
+    """A 20 s record: six nutation periods, for the rotor's fit."""
+    return _spinning_case(tmp_path_factory, 20.0)
+
+
+@pytest.fixture(scope="module")
+def short_spinning_case(tmp_path_factory):
+    """The same rig over 3 s, for the checks that build problems without fitting them."""
+    return _spinning_case(tmp_path_factory, 3.0)
+
+
+@pytest.mark.slow  # 80 s with its record; notebook 04 fits fixed,p1,r1 on six channels by default
 def test_six_channel_fit_recovers_rotor_and_pendulum(spinning_case):
     case = spinning_case
     model = model_from_spec("fixed,p1:nospring,r1", case)
@@ -61,18 +73,20 @@ def test_six_channel_fit_recovers_rotor_and_pendulum(spinning_case):
     assert np.allclose(simulated_line.get_ydata(), meas + resid)
 
 
-def test_channel_weights_override_the_default_scale(spinning_case):
-    model = model_from_spec("fixed,p1:nospring,r1", spinning_case)
-    prob = FitProblem.build(spinning_case, model, channel_weights={"torque_y": 0.5})
+def test_channel_weights_override_the_default_scale(short_spinning_case):
+    case = short_spinning_case
+    model = model_from_spec("fixed,p1:nospring,r1", case)
+    prob = FitProblem.build(case, model, channel_weights={"torque_y": 0.5})
     assert prob.channel_scales(0)["torque_y"] == 0.5
     with pytest.raises(KeyError, match="channel_weights: unknown channel `torque_w`"):
-        FitProblem.build(spinning_case, model, channel_weights={"torque_w": 1.0})
+        FitProblem.build(case, model, channel_weights={"torque_w": 1.0})
     with pytest.raises(ValueError, match=r"channel_weights: expected positive finite scales .*"
                                          r"`torque_y` = -1"):
-        FitProblem.build(spinning_case, model, channel_weights={"torque_y": -1})
+        FitProblem.build(case, model, channel_weights={"torque_y": -1})
 
 
-def test_spinning_model_specs(spinning_case):
+def test_spinning_model_specs(short_spinning_case):
+    spinning_case = short_spinning_case
     from analogs import Rotor, SphericalPendulum, SpinningRig
 
     model = model_from_spec("fixed,p1,rotor", spinning_case)
@@ -134,7 +148,8 @@ def test_channel_offsets_and_drifts_are_estimated_per_case(drifting_case):
     assert not any(n.endswith("_drift") for n in only.names)
 
 
-def test_channel_offsets_must_name_the_fitted_channels(spinning_case, drifting_case):
+def test_channel_offsets_must_name_the_fitted_channels(short_spinning_case, drifting_case):
+    spinning_case = short_spinning_case
     from estimate import ChannelOffsets
     from estimate.fitting.measurement import SensorOffset
 
