@@ -11,7 +11,7 @@ from ._compile import c_compiler, compiled
 from ._derive import derive
 from .derived import OUTPUT_NAMES, OUTPUT_UNITS, DerivedModel, ParameterError
 from .excitation import Excitation, NoExcitation, Sampled, Sine
-from .export_c import CExport, export_c
+from .export_c import CExport, export_c, has_c_compiler, run_driver, write_input_csv
 from .simulate import RK4, Adaptive, Simulation, rk4_step, simulate
 
 __all__ = [
@@ -32,8 +32,11 @@ __all__ = [
     "derive",
     "export_c",
     "export_fmu",
+    "has_c_compiler",
     "rk4_step",
+    "run_driver",
     "simulate",
+    "write_input_csv",
 ]
 
 

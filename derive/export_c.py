@@ -299,7 +299,8 @@ def _csv_value(v: float) -> str:
 
 def write_input_csv(path: str | os.PathLike, time: np.ndarray, inputs: np.ndarray,
                     names: tuple[str, ...]) -> Path:
-    """Write ``time`` (n,) and ``inputs`` (n, nu) as the driver's input CSV (full precision)."""
+    """Write ``time`` (n,) [s] and ``inputs`` (n, nu) as the driver's input CSV at ``path``
+    (full precision), the columns headed ``time`` and the input ``names``; returns the path."""
     path = Path(path)
     data = np.column_stack([np.asarray(time, float).ravel(),
                             np.asarray(inputs, float).reshape(len(time), -1)])
@@ -311,7 +312,10 @@ def write_input_csv(path: str | os.PathLike, time: np.ndarray, inputs: np.ndarra
 def run_driver(exe: str | os.PathLike, input_csv: str | os.PathLike, output_csv: str | os.PathLike,
                *, params_csv: str | os.PathLike | None = None, stages: bool = False
                ) -> np.ndarray:
-    """Run a built driver; returns the output CSV as an array (time, states, outputs)."""
+    """Run the built driver ``exe`` on ``input_csv`` (:func:`write_input_csv`), writing
+    ``output_csv``; ``params_csv`` overrides the parameter values built in, ``stages`` asks
+    for the RK4 stage values too. Returns the output CSV as an array (time, states,
+    outputs); raises RuntimeError naming the command when the driver fails."""
     cmd = [str(exe)]
     if params_csv is not None:
         cmd += ["--params", str(params_csv)]

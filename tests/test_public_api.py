@@ -261,3 +261,33 @@ def test_the_checks_catch_a_gap():
     assert _documented("plane", 'Swings in x (``plane="yz"``: in y).')
     assert _documented("hi", "lo, hi : float\n    Bounds.")
     assert _documented("rig", "test, rig\n    The tables.") and not _documented("rig", "rig\nno")
+
+
+def test_notebooks_import_only_from_package_faces():
+    """The notebooks show the API a user should use: every ``from analogs|derive|estimate...
+    import`` names a package (a folder with ``__init__.py``) and takes from it only names in
+    its ``__all__`` or its subpackages (``estimate.examples``)."""
+    import ast
+    import json
+
+    bad = []
+    for nb in sorted((ROOT / "notebooks").glob("*.ipynb")):
+        for cell in json.loads(nb.read_text())["cells"]:
+            if cell["cell_type"] != "code":
+                continue
+            src = "\n".join(line for line in "".join(cell["source"]).splitlines()
+                            if not line.lstrip().startswith(("%", "!")))
+            for node in ast.walk(ast.parse(src)):
+                if not (isinstance(node, ast.ImportFrom) and node.module
+                        and node.module.split(".")[0] in ("analogs", "derive", "estimate")):
+                    continue
+                face = importlib.import_module(node.module)
+                for alias in node.names:
+                    sub = f"{node.module}.{alias.name}"
+                    ok = hasattr(face, "__path__") and (
+                        alias.name in getattr(face, "__all__", ())
+                        or sub.replace(".", "/") in {p.parent.relative_to(ROOT).as_posix()
+                                                     for p in ROOT.rglob(f"{alias.name}/__init__.py")})
+                    if not ok:
+                        bad.append(f"{nb.name}: from {node.module} import {alias.name}")
+    assert not bad, bad

@@ -148,8 +148,9 @@ def summary(d: Diagnosis) -> str:
 
 
 def write_report(d: Diagnosis, folder: str | Path, *, overwrite: bool = False) -> Path:
-    """Write ``summary.md``, ``diagnosis.json``, ``fit_before_after.png``,
-    ``residual_spectra.png`` and ``parameters.md`` into ``folder``."""
+    """Write the report of the diagnosis ``d``: ``summary.md``, ``diagnosis.json``,
+    ``fit_before_after.png``, ``residual_spectra.png`` and ``parameters.md`` into ``folder``;
+    files already there are replaced only with ``overwrite`` (else FileExistsError)."""
     folder = Path(folder)
     existing = [n for n in REPORT_FILES if (folder / n).exists()]
     if existing and not overwrite:
@@ -178,7 +179,7 @@ def _model_text(res: FitResult) -> str:
 
 
 def before_after_figure(d: Diagnosis, path: str | Path | None = None):
-    """The measured force with the baseline's and the final model's simulation (zooms on the
+    """The diagnosis ``d``'s measured force with the baseline's and the final model's simulation (zooms on the
     start-up and the steady end), and the two residuals on their own, shared axis in N
     scaled by the baseline residual after the start-up (the start-up shaded), with the
     measurement noise as a band. ``path`` only decides how the figure is made (saved:
@@ -247,10 +248,11 @@ def before_after_figure(d: Diagnosis, path: str | Path | None = None):
 
 
 def residual_spectra_figure(d: Diagnosis, path: str | Path | None = None):
-    """Amplitude spectra (N/sqrt(Hz)) of the measured force and of the baseline and final
+    """Amplitude spectra (N/sqrt(Hz)) of the diagnosis ``d``'s measured force and of the baseline and final
     residuals (the baseline thick and light under the thin final), the raw data's noise
     floor, the drive frequency, the fitted mode frequencies of the final model and the
-    residual peaks the diagnosis found; returns the figure."""
+    residual peaks the diagnosis found. ``path`` only decides how the figure is made
+    (saved: without pyplot); returns the figure."""
     t = np.asarray(d.baseline.problem.experiments[0].case.time, float)
     fs = 1.0 / float(np.median(np.diff(t)))
     drive = drive_frequency_of(d.baseline)

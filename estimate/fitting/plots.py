@@ -200,7 +200,7 @@ def _trajectory_panel(ax, result) -> None:
 
 
 def plot_fit(result: "FitResult", path: str | Path | None = None, *, case: int = 0):
-    """The fit of ``case`` as a test engineer reads it.
+    """The fit ``result`` of ``case`` as a test engineer reads it.
 
     Panels: measured (thick, light) and simulated (thin, dark, dashed) force or, for
     multi-channel rigs, every fitted channel (N, N m), with zooms on the transient after the
