@@ -280,7 +280,8 @@ def _multichannel_evidence(result: FitResult, case: int) -> Evidence:
     chans = result.channels[case]
     w = result.weights[case] if result.weights else np.ones(t.size)
     keep = w > 0
-    r = result.scaled_residuals(case)[keep]
+    scaled = result.scaled_residuals(case).reshape(t.size, -1)
+    r = scaled[keep]
     power = np.sum(r**2, axis=0)
     total = float(power.sum()) or 1.0
     q, pval = _ljung_box(r[:, int(np.argmax(power))])
@@ -290,8 +291,7 @@ def _multichannel_evidence(result: FitResult, case: int) -> Evidence:
         drive_frequency=None, sweep=False, peaks=(), harmonics={}, ljung_box_q=q,
         ljung_box_p=pval, skew_correlation=0.0, skew_delay=0.0, frequency_ratio=None,
         pinned=pinned, channel_share={c: float(p / total) for c, p in zip(chans, power)},
-        residual_frequencies=_channel_lines(t, np.where(keep[:, None], result.scaled_residuals(
-            case).reshape(t.size, -1), 0.0)))
+        residual_frequencies=_channel_lines(t, np.where(keep[:, None], scaled, 0.0)))
 
 
 #: A spectral line of one channel's scaled residual counts where the residual concentrates

@@ -16,10 +16,10 @@ import math
 from collections.abc import Sequence
 
 import numpy as np
-from scipy.signal import welch
 
 from analogs import Model, Pendulum, SphericalPendulum
 
+from ...data.signals import welch_spectrum
 from ...fitting.result import FitResult
 from .base import Context, Family, Proposal, Score, frequency
 
@@ -88,7 +88,8 @@ def transverse_band_ratio(result: FitResult, case: int = 0, *,
     for k, c in enumerate(chans):
         if c not in channels:
             continue
-        f, p = welch(res[:, k], fs=fs, nperseg=min(t.size, int(round(16 * fs / f1))))
+        spec = welch_spectrum(t, res[:, k], nperseg=min(t.size, int(round(16 * fs / f1))))
+        f, p = spec.frequency, spec.psd
         band = (f >= BAND[0] * f1) & (f <= BAND[1] * f1)
         out = ~band & (f > 0)
         floor = float(np.median(p[out])) if out.any() else 0.0
