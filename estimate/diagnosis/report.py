@@ -4,6 +4,7 @@ a test engineer can read in a minute."""
 from __future__ import annotations
 
 import math
+from dataclasses import dataclass
 from pathlib import Path
 
 import numpy as np
@@ -28,15 +29,40 @@ def _filtered(res: FitResult) -> float | None:
     return res.problem.force_cutoff_hz if res.problem.input == "filtered" else None
 
 
-def _measured_label(res: FitResult) -> str:
-    """What the plotted measured force is: as recorded, low-passed, or with the tones above
-    the mechanics removed (the estimated input's force)."""
+def _measured_label(res: FitResult, shown: "_Shown | None" = None) -> str:
+    """What the plotted measured channel is: as recorded, low-passed, or with the tones
+    above the mechanics removed (the estimated input's force)."""
+    shown = shown or _Shown.of(res, {})
     cut = _filtered(res)
     if cut:
         return f"measured (low-passed at {cut:g} Hz)"
-    raw = res.problem.experiments[0].case.force
-    same = np.shape(res.measured[0]) == np.shape(raw) and np.array_equal(res.measured[0], raw)
+    raw = res.problem.experiments[0].case.channels[shown.name]
+    meas = shown.column(res.measured[0])
+    same = np.shape(meas) == np.shape(raw) and np.array_equal(meas, raw)
     return "measured" if same else "measured (tones above the mechanics removed)"
+
+
+@dataclass(frozen=True)
+class _Shown:
+    """The channel the report's figures show: the lateral force, or on a record of several
+    channels the one holding the largest share of the baseline's scaled residual; its
+    column in the fit's residual arrays (None: one channel) and unit."""
+
+    name: str
+    index: int | None
+    unit: str
+
+    @classmethod
+    def of(cls, res: FitResult, share: dict[str, float]) -> "_Shown":
+        chans = res.channels[0] if res.channels else ("force_x",)
+        if len(chans) == 1:
+            return cls(chans[0], None, "N")
+        name = max(chans, key=lambda c: share.get(c, 0.0))
+        return cls(name, chans.index(name), "N m" if name.startswith("torque") else "N")
+
+    def column(self, values) -> np.ndarray:
+        a = np.asarray(values, float)
+        return a if self.index is None else a.reshape(a.shape[0], -1)[:, self.index]
 
 
 def _parameter_rows(res: FitResult) -> list[str]:
@@ -105,10 +131,12 @@ def summary(d: Diagnosis) -> str:
     lines += ["", f"Final model: {' + '.join(d.final.problem.model.names)}"
               + (f" with {', '.join(type(m).__name__ for m in d.final.problem.measurement)}"
                  if d.final.problem.measurement else "")
-              + f"; RMS residual {d.baseline.rms_residual:.3g} N -> {d.final.rms_residual:.3g} N; "
+              + f"; RMS residual {d.baseline.rms_residual:.3g} {d.final_evidence.noise.unit} -> "
+              f"{d.final.rms_residual:.3g} {d.final_evidence.noise.unit}; "
               f"final {d.final_evidence.noise.text()}.", ""]
     lines += ["## The baseline's residual", "",
-              f"- RMS {ev.rms_residual:.3g} N on the fitted samples; {ev.noise.text()}.",
+              f"- RMS {ev.rms_residual:.3g} {ev.noise.unit} on the fitted samples; "
+              f"{ev.noise.text()}.",
               f"- Drive: {_drive_text(ev)}."]
     for p in ev.peaks:
         kind = f"drive harmonic {p.harmonic}" if p.harmonic else "not a drive harmonic"
@@ -185,8 +213,10 @@ def before_after_figure(d: Diagnosis, path: str | Path | None = None):
     measurement noise as a band. ``path`` only decides how the figure is made (saved:
     without pyplot); returns the figure."""
     t = np.asarray(d.baseline.problem.experiments[0].case.time, float)
-    meas = d.baseline.measured[0]
-    base, final = d.baseline.simulated(0), d.final.simulated(0)
+    shown = _Shown.of(d.baseline, d.baseline_evidence.channel_share)
+    unit = shown.unit
+    meas = shown.column(d.baseline.measured[0])
+    base, final = shown.column(d.baseline.simulated(0)), shown.column(d.final.simulated(0))
     # the baseline's simulation in its held-out blocks follows a carriage motion read off
     # the displacement alone: shaded and left blank, as in its residual panel
     held_base = (d.baseline.weights[0] == 0) if d.baseline.weights else np.zeros(t.size, bool)
@@ -195,13 +225,14 @@ def before_after_figure(d: Diagnosis, path: str | Path | None = None):
     ax = fig.subplots(3, 1, sharex=True, height_ratios=[2.2, 1, 1])
     for lo, hi in _runs(t, held_base):
         ax[0].axvspan(lo, hi, color="#fee08b", alpha=0.5, lw=0, zorder=0)
-    ax[0].plot(t, meas, **style.MEASURED, label=_measured_label(d.baseline))
+    ax[0].plot(t, meas, **style.MEASURED, label=_measured_label(d.baseline, shown))
     base_style = {**style.SIMULATED, "color": "#e08214", "ls": (0, (2, 1.5))}
     final_style = {**style.SIMULATED, "ls": "-"}
     ax[0].plot(t, base, **base_style, label=f"baseline ({_model_text(d.baseline)})")
     ax[0].plot(t, final, **final_style, label=f"final ({_model_text(d.final)})")
     top = float(np.max(np.abs(meas))) or 1.0
-    ax[0].set(ylabel="force_x [N]", ylim=(-1.1 * top, style.ZOOM_TOP * top), xlim=(t[0], t[-1]))
+    ax[0].set(ylabel=f"{shown.name} [{unit}]", ylim=(-1.1 * top, style.ZOOM_TOP * top),
+              xlim=(t[0], t[-1]))
     ax[0].set_yticks([tk for tk in ax[0].get_yticks() if abs(tk) <= 1.1 * top])
     end = style.startup_end(t)
     span = max(1.0, 0.06 * (t[-1] - t[0]), end - t[0])
@@ -221,29 +252,34 @@ def before_after_figure(d: Diagnosis, path: str | Path | None = None):
     def fitted(res: FitResult) -> np.ndarray:  # after the start-up, not held out
         return steady & (res.weights[0] > 0) if res.weights else steady
 
-    limit = max(style.robust_limit(d.baseline.residuals[0], fitted(d.baseline)),
-                style.robust_limit(d.final.residuals[0], fitted(d.final)))
-    noise = d.baseline_evidence.noise_rms
+    limit = max(style.robust_limit(shown.column(d.baseline.residuals[0]), fitted(d.baseline)),
+                style.robust_limit(shown.column(d.final.residuals[0]), fitted(d.final)))
+    figure = d.baseline.noise_figure(0, shown.name) if shown.index is not None else None
+    noise = figure.std if figure is not None else d.baseline_evidence.noise_rms
     for a, res, name in ((ax[1], d.baseline, "baseline"), (ax[2], d.final, "final")):
         # the held-out blocks are no residual of the fitted model: the carriage motion there
         # rests on the displacement alone, so they are shaded and left blank
         held = (res.weights[0] == 0) if res.weights else np.zeros(t.size, bool)
-        r = np.where(held, np.nan, res.residuals[0])
-        a.axhspan(-noise, noise, color="#4393c3", alpha=0.2, lw=0, label=f"noise RMS +/-{noise:.3g} N")
+        resid = shown.column(res.residuals[0])
+        r = np.where(held, np.nan, resid)
+        a.axhspan(-noise, noise, color="#4393c3", alpha=0.2, lw=0,
+                  label=f"noise RMS +/-{noise:.3g} {unit}")
         a.plot(t, r, **style.RESIDUAL, label=f"{name} residual")
         for i, (lo, hi) in enumerate(_runs(t, held)):
             a.axvspan(lo, hi, color="#fee08b", alpha=0.5, lw=0, zorder=0,
                       label="held out of this fit (not shown)" if i == 0 else None)
             a.text(0.5 * (lo + hi), 0.0, "held out", ha="center", va="center", fontsize="small",
                    color="0.35")
-        style.mark_startup(a, t, np.abs(np.nan_to_num(r)), end, limit, "N")
-        rms = float(np.sqrt(np.mean(res.residuals[0][fitted(res)] ** 2)))
-        a.set(ylabel="residual [N]", ylim=(-limit, limit))
-        a.set_title(f"{name} ({_model_text(res)}): RMS residual {rms:.3g} N on the fitted samples "
-                    "after the start-up", fontsize="medium", loc="left")
+        style.mark_startup(a, t, np.abs(np.nan_to_num(r)), end, limit, unit)
+        rms = float(np.sqrt(np.mean(resid[fitted(res)] ** 2)))
+        a.set(ylabel=f"residual [{unit}]", ylim=(-limit, limit))
+        a.set_title(f"{name} ({_model_text(res)}): RMS residual {rms:.3g} {unit} on the fitted "
+                    "samples after the start-up", fontsize="medium", loc="left")
         a.legend(loc="lower right", fontsize="small", ncols=4)
     ax[2].set_xlabel("time [s]")
-    fig.suptitle(f"Diagnosis of {d.baseline.problem.experiments[0].case.test.id}: before and after")
+    across = "" if shown.index is None else f" ({shown.name}: the channel with most residual)"
+    fig.suptitle(f"Diagnosis of {d.baseline.problem.experiments[0].case.test.id}: before and "
+                 f"after{across}")
     return fig
 
 
@@ -254,8 +290,9 @@ def residual_spectra_figure(d: Diagnosis, path: str | Path | None = None):
     residual peaks the diagnosis found. ``path`` only decides how the figure is made
     (saved: without pyplot); returns the figure."""
     t = np.asarray(d.baseline.problem.experiments[0].case.time, float)
+    shown = _Shown.of(d.baseline, d.baseline_evidence.channel_share)
     fs = 1.0 / float(np.median(np.diff(t)))
-    drive = drive_frequency_of(d.baseline)
+    drive = drive_frequency_of(d.baseline) if shown.index is None else None
     modes = mode_frequencies(d.final)
     top_f = spectrum_top(fs, d.baseline.problem.force_cutoff_hz, [drive or 0.0, *modes.values()])
     fig = style.figure(path, figsize=(10, 5))
@@ -265,17 +302,18 @@ def residual_spectra_figure(d: Diagnosis, path: str | Path | None = None):
     # density scaled back by the fitted share): the held-out blocks are no residual of it
     w = d.baseline.weights[0] > 0 if d.baseline.weights else np.ones(t.size, bool)
     for y, share, label, kw in (
-            (d.baseline.measured[0], 1.0, _measured_label(d.baseline), {"color": "0.75", "lw": 1.0}),
-            (np.where(w, d.baseline.residuals[0], 0.0), float(np.mean(w)),
+            (shown.column(d.baseline.measured[0]), 1.0, _measured_label(d.baseline, shown),
+             {"color": "0.75", "lw": 1.0}),
+            (np.where(w, shown.column(d.baseline.residuals[0]), 0.0), float(np.mean(w)),
              f"baseline residual ({_model_text(d.baseline)}), fitted samples",
              {"color": "#e08214", "lw": 2.4, "alpha": 0.7}),
-            (d.final.residuals[0], 1.0, f"final residual ({_model_text(d.final)})",
+            (shown.column(d.final.residuals[0]), 1.0, f"final residual ({_model_text(d.final)})",
              {"color": "0.1", "lw": 0.9})):
         sp = welch_spectrum(t, y)
         band = (sp.frequency <= top_f)
         ax.semilogy(sp.frequency[band], np.sqrt(sp.psd[band] / share), label=label, **kw)
         curves.append(np.sqrt(sp.psd[band & (sp.frequency > 0)] / share))
-    floor = noise_density(d.baseline, "force_x")
+    floor = noise_density(d.baseline, shown.name)
     if floor is not None:
         ax.axhline(floor, label="noise floor (raw data)", gid="noise floor", **style.NOISE)
     if drive is not None and drive < top_f:
@@ -289,11 +327,13 @@ def residual_spectra_figure(d: Diagnosis, path: str | Path | None = None):
     cut = d.baseline.problem.force_cutoff_hz
     if cut and cut < top_f:
         ax.axvspan(cut, top_f, **style.DISCOUNT, label=f"above the {cut:g} Hz force filter")
-    ax.set(xlabel="frequency [Hz]", ylabel="amplitude density [N/sqrt(Hz)]", xlim=(0, top_f),
+    ax.set(xlabel="frequency [Hz]", ylabel=f"amplitude density [{shown.unit}/sqrt(Hz)]",
+           xlim=(0, top_f),
            ylim=style.spectrum_limits(curves, floor))
     ax.set_title(("Residual spectra: what the baseline misses and the final model explains"
                   if d.findings else "Residual spectra of the baseline (no finding)")
-                 + (" (drive: a sweep)" if drive is None else ""))
+                 + (f" ({shown.name})" if shown.index is not None
+                    else " (drive: a sweep)" if drive is None else ""))
     ax.legend(loc="upper right", fontsize="small", ncols=2)
     return fig
 

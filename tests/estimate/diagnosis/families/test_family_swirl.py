@@ -15,9 +15,9 @@ Swirl is proposed on the first from the transverse channels' slosh band and its 
 (planar pendulum made spherical, same parameters) recovers the first mode: mass within 2 %
 and frequency within 0.3 % (issue 29's tolerances); it is not proposed on the second, and the
 third starts from a spherical pendulum. A force-only record of the first names swirl or
-nothing, never a lateral family (none applies). The channel offsets are proposed on a
-record with known offsets and drifts and recover them within 3 standard errors, and are
-not proposed on one without."""
+nothing, never a lateral family (none applies); the report shows the transverse channel.
+The channel offsets are proposed on a record with known offsets and drifts and recover
+them within 3 standard errors, and are not proposed on one without."""
 
 from __future__ import annotations
 
@@ -32,6 +32,7 @@ from motion_cases import PENDULUM, make_motion_case, truth
 
 from analogs import Pendulum, SphericalPendulum
 from estimate import diagnose
+from estimate.diagnosis import before_after_figure, write_report
 from estimate.diagnosis.families import FAMILIES
 from estimate.diagnosis.families.swirl import (
     MIN_BAND_RATIO,
@@ -106,6 +107,12 @@ def test_the_diagnosis_names_swirl_and_no_lateral_family(swirling, tmp_path):
     d = diagnose(swirling, progress=False)
     assert d.findings and d.findings[0].cause == "swirl", [f.cause for f in d.findings]
     assert {f.cause for f in d.findings} <= {"swirl", "channel_offsets"}
+    # the report shows the channel holding most of the baseline's residual (a transverse
+    # one here), in its unit; the summary's residuals are in channel scales
+    write_report(d, tmp_path / "report")
+    fig = before_after_figure(d)
+    assert fig.axes[0].get_ylabel() in ("force_y [N]", "torque_x [N m]"), fig.axes[0].get_ylabel()
+    assert "(channel scales)" in (tmp_path / "report" / "summary.md").read_text()
     # the force along the drive alone: swirl or nothing, never a lateral family
     case, _ = _record(tmp_path, "X", _planar(0.0016, 1.01), 11, channels=("force_x",))
     d = diagnose(case, progress=False)
