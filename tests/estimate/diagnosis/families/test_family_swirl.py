@@ -117,7 +117,10 @@ def test_the_diagnosis_names_swirl_and_no_lateral_family(swirling, tmp_path):
     case, _ = _record(tmp_path, "X", _planar(0.0016, 1.01), 11, channels=("force_x",))
     d = diagnose(case, progress=False)
     assert {f.cause for f in d.findings} <= {"swirl", "channel_offsets"}
-    assert d.findings or not d.verdict.explained
+    # the issue allows "unexplained" here; the record's 1 % cross-axis drive seeds the
+    # swirl in the model too, so it is named and the first mode recovered
+    assert d.findings and d.findings[0].cause == "swirl", d.verdict.text
+    assert d.final.value("p1.mass") == pytest.approx(truth()["p1.mass"], rel=MASS_TOL)
 
 
 def _with_offsets(case, offsets: dict[str, tuple[float, float]]):
