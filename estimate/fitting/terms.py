@@ -23,10 +23,16 @@ from .transcription import Block, InputCoefficients, Transcription
 __all__ = ["CaseTerms", "WarmStart", "case_terms"]
 
 
-def _measured_output(dm, channels: tuple[str, ...]) -> ca.Function:
-    """``(x, u, p, t) -> y``: the measured ``channels`` (built once per model)."""
+def _measured_output(dm, channels: tuple[str, ...], compiled: bool = False) -> ca.Function:
+    """``(x, u, p, t) -> y``: the measured ``channels`` (built once per model), compiled
+    to C when asked (then without CasADi derivatives)."""
+    if compiled:
+        from derive import compiled as compile_fn
+
+        return dm.memo(("measured_output_compiled", channels),
+                       lambda: compile_fn(_measured_output(dm, channels)))
     return dm.memo(("measured_output", channels),
-                       lambda: _measured_output_function(dm, channels))
+                   lambda: _measured_output_function(dm, channels))
 
 
 def _measured_output_function(dm, channels: tuple[str, ...]) -> ca.Function:
@@ -166,8 +172,13 @@ def case_terms(problem: FitProblem, i: int, theta_s: ca.MX, transcription: Trans
         block = steady_start(block, dm, p_i, theta_s, np.asarray(u0).ravel(), float(t[0]),
                              coef.numel())
     chans = problem.channels(i)
-    Y = dm.mapped(("measured_output", chans), _measured_output(dm, chans), n)(
-        block.X, Ug, p_i, ca.DM(t).T).T
+    assembled = cost == "squared" and blocks_ok and block.jac_w is not None and dm.nx
+    # with the residual Jacobian assembled nothing differentiates Y: its states may come
+    # from compiled steps
+    fast = bool(assembled and compile_)
+    Xy = block.X_fast if fast and block.X_fast is not None else block.X
+    Y = dm.mapped(("measured_output", chans, fast), _measured_output(dm, chans, fast), n)(
+        Xy, Ug, p_i, ca.DM(t).T).T
     mvals = {e.parameter: theta_s[j] * e.scale for j, e in enumerate(problem.estimated)
              if e.case in (None, i)}
     extras = [x for x in (mm.term(Ug, dm.inputs, mvals, t) for mm in problem.measurement)
@@ -209,11 +220,18 @@ def case_terms(problem: FitProblem, i: int, theta_s: ca.MX, transcription: Trans
         e = ca.vertcat(e, ex)
         r = e if cost == "squared" else ca.vertcat(r, ex)
     jac = None
-    if cost == "squared" and blocks_ok and block.jac_w is not None and dm.nx:
+    if assembled:
         factor = wv / np.repeat(s, n)
-        jt, jx, jc = force_residual_jacobian(
-            dm, chans, block.X, Ug, p_i, theta_s, t, factor, initial_state == "rest",
-            compile_, None if carriage is None else A_grid)
+        if block.state_jacobian is not None:  # states simulated from coarser nodes
+            from .condensed import residual_jacobian
+
+            jt, jx, jc = residual_jacobian(dm, chans, block.state_jacobian, Ug, p_i, theta_s,
+                                           t, factor, compile_,
+                                           None if carriage is None else A_grid)
+        else:
+            jt, jx, jc = force_residual_jacobian(
+                dm, chans, block.X, Ug, p_i, theta_s, t, factor, initial_state == "rest",
+                compile_, None if carriage is None else A_grid)
         if extras:
             ye = sum(extras[1:], extras[0])
             if ye.shape != Y.shape:  # a term of one column added to every channel

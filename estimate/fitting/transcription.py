@@ -51,6 +51,14 @@ class Block:
     g_fast: ca.MX | None = None
     jac_c: ca.MX | None = None
     g_jac: ca.MX | None = None
+    #: With nodes coarser than the samples (:mod:`estimate.fitting.condensed`), the
+    #: states on the samples are expressions: their per-step sensitivities
+    #: (:class:`~estimate.fitting.condensed.StepSensitivities`). ``None``: the columns of
+    #: ``X`` are the variables ``w`` themselves (after a fixed first column).
+    state_jacobian: object | None = None
+    #: ``X`` as IPOPT evaluates it (from compiled steps, so without CasADi derivatives),
+    #: when the states on the samples are expressions; ``None``: ``X``.
+    X_fast: ca.MX | None = None
 
 
 @dataclass(frozen=True)
@@ -69,6 +77,10 @@ class Transcription:
     def fractions(self) -> np.ndarray:
         """Times within an interval, as fractions of its length, where inputs are needed."""
         raise NotImplementedError
+
+    def describe(self, times: list[np.ndarray]) -> str:
+        """What was used on records with the sample times ``times`` (reports)."""
+        return repr(self)
 
     def inputs(self, exc: Excitation | None, t: np.ndarray, nu: int) -> np.ndarray:
         """Input values needed per interval, shape ``(len(fractions) * nu, n - 1)``."""
@@ -95,17 +107,48 @@ def _states_with_fixed_start(nx: int, n: int, x_guess: np.ndarray, x0: np.ndarra
 
 @dataclass(frozen=True)
 class MultipleShooting(Transcription):
-    """States at every sample are decision variables; continuity is enforced after
+    """States at the nodes are decision variables; continuity is enforced after
     ``substeps`` RK4 steps per sample interval (one step per 10 ms sample is as accurate as
-    two for slosh frequencies below ~5 Hz)."""
+    two for slosh frequencies below ~5 Hz).
+
+    ``samples_per_interval`` sets the nodes: one every that many samples, the states in
+    between simulated from the node (:mod:`estimate.fitting.condensed`); ``None`` (default)
+    chooses from the sample rate (:func:`interval_samples`); 1 puts a node at every sample.
+    """
 
     substeps: int = 1
+    samples_per_interval: int | None = None
+
+    def __post_init__(self) -> None:
+        k = self.samples_per_interval
+        if k is not None and (not isinstance(k, (int, np.integer)) or k < 1):
+            raise ValueError(f"MultipleShooting samples_per_interval must be a positive "
+                             f"integer or None, got {k!r}")
 
     def fractions(self):
         return np.arange(2 * self.substeps + 1) / (2 * self.substeps)
 
+    def describe(self, times: list[np.ndarray]) -> str:
+        ks = sorted({self.interval_samples(np.asarray(t, float)) for t in times})
+        k = ks[0] if len(ks) == 1 else tuple(ks)
+        return f"MultipleShooting(substeps={self.substeps}, samples_per_interval={k})"
+
+    def interval_samples(self, t: np.ndarray) -> int:
+        """Samples per shooting interval on the sample times ``t``: the given
+        ``samples_per_interval``, else :func:`interval_samples`."""
+        k = self.samples_per_interval
+        return interval_samples(t) if k is None else max(1, min(int(k), (t.size - 1) // 2))
+
     def block(self, dm, p, t, U, x_guess, x0, theta=None, compiled=False, coefficients=None):
         n = t.size
+        K = self.interval_samples(t) if dm.nx else 1
+        if K > 1:
+            from .condensed import condensed_block
+
+            block = condensed_block(dm, self.substeps, K, p, t, U, x_guess, x0, theta,
+                                    compiled, coefficients)
+            if block is not None:
+                return block
         W, X, w0 = _states_with_fixed_start(dm.nx, n, x_guess, x0)
         step = rk4_step(dm, self.substeps)
         tk, hk = ca.DM(t[:-1]).T, ca.DM(np.diff(t)).T
@@ -135,6 +178,25 @@ class MultipleShooting(Transcription):
             jac_c = ca.mtimes(_block_diagonal(dm.nx, nU, n - 1, -JuT), coefficients.A)
         return Block(ca.vec(W), np.asarray(w0).ravel(order="F"), g, X, jac_theta, jac_w,
                      g_fast, jac_c, ca.vec(X[:, 1:] - xn))
+
+
+#: Longest shooting interval chosen automatically [s], and most samples in it. Within
+#: 20 ms a slosh mode below ~5 Hz turns by less than 40 degrees, so the interval's states
+#: stay nearly linear in its node and the Gauss-Newton steps as good as with a node per
+#: sample.
+INTERVAL_SECONDS = 0.02
+INTERVAL_SAMPLES_MAX = 16
+
+
+def interval_samples(t: np.ndarray) -> int:
+    """Samples per shooting interval for sample times ``t``: as many as fit in
+    :data:`INTERVAL_SECONDS` (at most :data:`INTERVAL_SAMPLES_MAX`, and at least two
+    intervals per record)."""
+    if t.size < 5:
+        return 1
+    dt = float(np.median(np.diff(t)))
+    k = int(np.floor(INTERVAL_SECONDS / dt + 1e-9)) if dt > 0 else 1
+    return max(1, min(k, INTERVAL_SAMPLES_MAX, (t.size - 1) // 2))
 
 
 def _compiled_step(dm: DerivedModel, substeps: int) -> ca.Function:

@@ -1,7 +1,9 @@
 """The residual Jacobian assembled from per-sample blocks equals CasADi's automatic
 differentiation of the residual expression, for every variant the fit builds: estimated and
 filtered input, a fixed and a free start, two pendulums, a measurement model with its own
-parameters, two cases at once and weighted samples (a sensor delay zeroes the last ones)."""
+parameters, two cases at once and weighted samples (a sensor delay zeroes the last ones);
+each with a shooting node at every sample and with one every 3 samples (the states in
+between simulated with forward sensitivities, the last interval padded: 300 samples)."""
 
 from __future__ import annotations
 
@@ -37,15 +39,19 @@ VARIANTS = {
 }
 
 
+@pytest.mark.parametrize("per_interval", [1, 3])
 @pytest.mark.parametrize("variant", VARIANTS)
-def test_assembled_residual_jacobian_equals_automatic_differentiation(cases, variant):
+def test_assembled_residual_jacobian_equals_automatic_differentiation(cases, variant,
+                                                                      per_interval):
     ncases, spec, mode, measurement, start = VARIANTS[variant]
     chosen = cases[:ncases]
     problem = FitProblem.build(chosen if ncases > 1 else chosen[0],
                                model_from_spec(spec, chosen[0]), input=mode,
                                measurement=list(measurement))
-    nlp, terms = _setup(problem, MultipleShooting(), "squared", [start] * ncases, True, False,
-                        None)
+    nlp, terms = _setup(problem, MultipleShooting(samples_per_interval=per_interval),
+                        "squared", [start] * ncases, True, False, None)
+    condensed = [t.block.state_jacobian is not None for t in terms]
+    assert all(condensed) == (per_interval > 1)
     assert all(t.jacobian is not None for t in terms)  # the assembled path is the one tested
     f = ca.Function("f", [nlp.w], [nlp.jac_r, ca.jacobian(nlp.r, nlp.w)])
     w = nlp.w0 * (1 + 0.05 * np.random.default_rng(3).standard_normal(nlp.w0.size))
@@ -54,9 +60,11 @@ def test_assembled_residual_jacobian_equals_automatic_differentiation(cases, var
     assert np.max(np.abs(assembled - automatic)) <= 1e-12 * np.max(np.abs(automatic))
 
 
-@pytest.mark.parametrize("steady, offsets", [(False, False), (True, False), (False, True)])
+@pytest.mark.parametrize("steady, offsets, per_interval",
+                         [(False, False, 1), (True, False, 1), (False, True, 1),
+                          (True, True, 4)])
 def test_six_channel_residual_jacobian_equals_automatic_differentiation(tmp_path, steady,
-                                                                        offsets):
+                                                                        offsets, per_interval):
     """The spinning rig: six channels of different units (scaled per channel), a pendulum
     and a rotor, from rest or from the steady relative equilibrium, with or without every
     channel's offset and drift estimated."""
@@ -74,19 +82,23 @@ def test_six_channel_residual_jacobian_equals_automatic_differentiation(tmp_path
     problem = FitProblem.build(case, model_from_spec("fixed,p1,r1", case),
                                measurement=(ChannelOffsets(),) if offsets else ())
     kind = "steady" if steady else "rest"
-    nlp, terms = _setup(problem, MultipleShooting(), "squared", [kind], True, False, None)
+    nlp, terms = _setup(problem, MultipleShooting(samples_per_interval=per_interval),
+                        "squared", [kind], True, False, None)
     assert len(problem.channels(0)) == 6 and terms[0].jacobian is not None
+    assert (terms[0].block.state_jacobian is not None) == (per_interval > 1)
     f = ca.Function("f", [nlp.w], [nlp.jac_r, ca.jacobian(nlp.r, nlp.w)])
     w = nlp.w0 * (1 + 0.05 * np.random.default_rng(4).standard_normal(nlp.w0.size))
     assembled, automatic = (np.asarray(m.full()) for m in f(w))
     assert np.max(np.abs(assembled - automatic)) <= 1e-12 * np.max(np.abs(automatic))
 
 
+@pytest.mark.parametrize("per_interval", [1, 3])
 @pytest.mark.parametrize("compiled", [False, True])
 @pytest.mark.parametrize("variant", ["estimated rest", "estimated free", "two cases",
                                      "filtered rest"])
 def test_constraint_jacobian_and_fast_constraints_equal_the_interpreted_ones(cases, variant,
-                                                                              compiled):
+                                                                              compiled,
+                                                                              per_interval):
     """What IPOPT evaluates: the constraint Jacobian assembled from per-interval blocks
     (bidiagonal state blocks, block-diagonal input blocks times the carriage spline) equals
     CasADi's automatic differentiation of the interpreted constraints, and the constraints
@@ -100,8 +112,8 @@ def test_constraint_jacobian_and_fast_constraints_equal_the_interpreted_ones(cas
     chosen = cases[:ncases]
     problem = FitProblem.build(chosen if ncases > 1 else chosen[0],
                                model_from_spec(spec, chosen[0]), input=mode)
-    nlp, _ = _setup(problem, MultipleShooting(), "squared", [start] * ncases, True, compiled,
-                    None)
+    shooting = MultipleShooting(samples_per_interval=per_interval)
+    nlp, _ = _setup(problem, shooting, "squared", [start] * ncases, True, compiled, None)
     jac_g = nlp.constraint_jacobian(True)
     assert jac_g is not None
     w = nlp.w0 * (1 + 0.05 * np.random.default_rng(5).standard_normal(nlp.w0.size))
@@ -112,3 +124,9 @@ def test_constraint_jacobian_and_fast_constraints_equal_the_interpreted_ones(cas
     assert np.max(np.abs(J_blocks - J)) <= 1e-12 * scale
     for other in (g_blocks, g_fast):
         assert np.max(np.abs(other - g)) <= 1e-12 * max(np.max(np.abs(w)), 1.0)
+    # the residuals IPOPT evaluates (states from compiled steps when condensed) equal the
+    # interpreted, differentiable ones
+    plain, _ = _setup(problem, shooting, "squared", [start] * ncases, False, False, None)
+    r_fast = np.asarray(ca.Function("r", [nlp.w], [nlp.r])(w).full()).ravel()
+    r_plain = np.asarray(ca.Function("r", [plain.w], [plain.r])(w).full()).ravel()
+    assert np.max(np.abs(r_fast - r_plain)) <= 1e-10 * max(np.max(np.abs(r_plain)), 1.0)

@@ -1,0 +1,400 @@
+"""Multiple shooting on a grid coarser than the samples: one shooting interval per ``K``
+samples, the states at the samples inside an interval simulated from its node.
+
+With a node at every sample (``K = 1``) a long record's NLP carries ``nx`` variables and
+``nx`` continuity constraints per sample, and IPOPT's KKT systems grow with them. Here the
+nodes are every ``K``-th sample and each interval runs its ``K`` RK4 steps from its node
+(the same steps on the same sample grid: the same discrete model and the same optimum).
+The steps carry forward sensitivities of the states w.r.t. the node, the parameters and
+the few carriage coefficients the interval depends on; they give the constraint Jacobian
+(node to node) and the states' Jacobian (sample by sample), which the residual Jacobian
+chains with the outputs' (:mod:`estimate.fitting.terms`). A 30,001-sample fit's KKT has
+121,000 rows with a node per sample, 13,000 with one every 10.
+
+The last interval is padded to ``K`` steps with steps of zero length (an RK4 step of
+``h = 0`` returns its state), so step ``j`` of every interval is one mapped evaluation.
+"""
+
+from __future__ import annotations
+
+from dataclasses import dataclass
+
+import casadi as ca
+import numpy as np
+
+from derive import DerivedModel, rk4_step
+from derive import compiled as compile_fn
+
+from ._sparse import affine_parameters, scatter
+
+__all__ = ["condensed_block", "padded_grid", "residual_jacobian", "StepSensitivities"]
+
+
+#: Most carriage coefficients one interval's inputs may depend on (a B-spline's are a
+#: few per interval; an input whose coefficients are not local is shot from every sample).
+WINDOW_MAX = 64
+
+
+def padded_grid(t: np.ndarray, K: int) -> tuple[int, np.ndarray, np.ndarray]:
+    """``(m, tk, hk)``: the number of intervals of ``K`` sample steps covering ``t``, and
+    the start time and length of each of their ``m K`` steps (zero-length past the end)."""
+    n = t.size
+    m = -(-(n - 1) // K)
+    steps = m * K
+    tk = np.full(steps, float(t[-1]))
+    hk = np.zeros(steps)
+    tk[: n - 1] = t[:-1]
+    hk[: n - 1] = np.diff(t)
+    return m, tk, hk
+
+
+def _propagation(dm: DerivedModel, substeps: int, ntheta: int, width: int,
+                 compiled: bool) -> ca.Function:
+    """One RK4 step carrying forward sensitivities: ``(x, U, B, p0, vec(S), theta, t, h,
+    Sx, St, Sc) -> (x+, Sx+, St+, Sc+)`` with ``p = p0 + S theta``, ``Sx+ = A Sx``,
+    ``St+ = A St + dx+/dtheta``, ``Sc+ = A Sc + dx+/dU B`` (``A = dx+/dx``): the states'
+    derivatives w.r.t. the interval's node, the scaled parameters and a window of
+    ``width`` coefficients of an estimated input (``U = B c``; ``B`` empty when the inputs
+    are data). Built (and compiled) once per model, substeps, estimates and width."""
+    key = ("condensed_propagation", substeps, ntheta, width, compiled)
+
+    def build() -> ca.Function:
+        step = rk4_step(dm, substeps)
+        nU, nx = step.size1_in(1), dm.nx
+        npar = len(dm.parameter_names)
+        x = ca.SX.sym("x", nx)
+        U = ca.SX.sym("U", nU)
+        B = ca.SX.sym("B", nU, width)
+        p0 = ca.SX.sym("p0", npar)
+        Sv = ca.SX.sym("S", npar * ntheta)
+        th = ca.SX.sym("theta", ntheta)
+        t, h = ca.SX.sym("t"), ca.SX.sym("h")
+        Sx = ca.SX.sym("Sx", nx, nx)
+        St = ca.SX.sym("St", nx, ntheta)
+        Sc = ca.SX.sym("Sc", nx, width)
+        xn = step(x, U, p0 + ca.mtimes(ca.reshape(Sv, npar, ntheta), th), t, h)
+        A = ca.jacobian(xn, x)
+        outs = [xn, ca.densify(ca.mtimes(A, Sx)),
+                ca.densify(ca.mtimes(A, St) + ca.jacobian(xn, th)),
+                ca.densify(ca.mtimes(A, Sc) + ca.jtimes(xn, U, B)) if width else ca.SX(nx, 0)]
+        fn = ca.Function("condensed_propagation", [x, U, B, p0, Sv, th, t, h, Sx, St, Sc], outs)
+        if compiled:
+            fn = compile_fn(fn)
+        return fn
+
+    return dm.memo(key, build)
+
+
+def condensed_block(dm: DerivedModel, substeps: int, K: int, p: ca.MX, t: np.ndarray,
+                    U: ca.DM | ca.MX, x_guess: np.ndarray, x0: np.ndarray | None,
+                    theta: ca.MX | None, compiled: bool, coefficients):
+    """The :class:`~estimate.fitting.transcription.Block` of one case with a node every
+    ``K`` samples (arguments as :meth:`MultipleShooting.block`), or ``None`` when an
+    estimated input's intervals depend on more than :data:`WINDOW_MAX` coefficients.
+
+    Step ``j`` of every interval is one mapped evaluation (``K`` of them in all), so the
+    expression graph and the compiled code do not grow with ``K`` or the record."""
+    from .transcription import Block, _bidiagonal, _compiled_step
+
+    n, nx = t.size, dm.nx
+    m, tk, hk = padded_grid(t, K)
+    nU = int(U.size1())
+    pad = m * K - (n - 1)
+    Up = ca.horzcat(U, ca.DM.zeros(nU, pad)) if pad else U
+    # step j of every interval: its stage inputs (nU x m), start times and lengths (1 x m)
+    Uj = [Up[:, j::K] for j in range(K)]
+    tj = [ca.DM(tk[j::K]).T for j in range(K)]
+    hj = [ca.DM(hk[j::K]).T for j in range(K)]
+    nodes = np.arange(m) * K
+    fixed = x0 is not None
+    W = ca.MX.sym("X", nx, m - 1 if fixed else m)
+    N = ca.horzcat(ca.DM(x0), W) if fixed else W  # node states, one column per interval
+    w0 = np.asarray(x_guess)[:, nodes[1:] if fixed else nodes]
+
+    def run(step_map) -> list[ca.MX]:  # the states after each step, nx x m each
+        xs, x = [], N
+        for j in range(K):
+            x = step_map(x, Uj[j], p, tj[j], hj[j])
+            xs.append(x)
+        return xs
+
+    # sample s = k K + j + 1 is entry k of step j: its place among the steps' states
+    # stacked (one gather, not a vertcat of K matrices and a reshape)
+    s_ = np.arange(1, n)
+    order = (((s_ - 1) % K)[:, None] * nx * m + ((s_ - 1) // K)[:, None] * nx
+             + np.arange(nx)[None, :]).ravel().tolist()
+
+    def states(xs: list[ca.MX]) -> ca.MX:  # nx x n on the samples
+        stacked = ca.vertcat(*[ca.vec(x) for x in xs])
+        return ca.horzcat(N[:, 0], ca.reshape(stacked[order], nx, n - 1))
+
+    def continuity(last: ca.MX) -> ca.MX:  # node k + 1 = the end of interval k
+        return ca.vec(N[:, 1:] - last[:, : m - 1])
+
+    step = rk4_step(dm, substeps)
+    xs = run(dm.mapped(("rk4_step", substeps), step, m))
+    X, g = states(xs), continuity(xs[-1])
+    if theta is None:
+        return Block(ca.vec(W), w0.ravel(order="F"), g, X)
+    g_fast, X_fast = g, X
+    if compiled:  # what IPOPT evaluates: compiled steps (no CasADi derivatives)
+        xs_fast = run(dm.mapped(("rk4_step_compiled", substeps), _compiled_step(dm, substeps), m))
+        g_fast, X_fast = continuity(xs_fast[-1]), states(xs_fast)
+    ntheta_all = theta.numel()
+    p0, S, cols, theta = _dynamic_parameters(p, theta)
+    ntheta = len(cols)
+    win = None if coefficients is None else _Windows.of(coefficients.A, m, nU, K)
+    if win is not None and win.width > WINDOW_MAX:
+        return None  # inputs not local in their coefficients: a node per sample instead
+    width = 0 if win is None else win.width
+    prop = dm.mapped(("condensed_propagation", substeps, ntheta, width, compiled),
+                     _propagation(dm, substeps, ntheta, width, compiled), m)
+    x = N
+    Sx = ca.DM(np.tile(np.eye(nx), (1, m)))
+    St = ca.DM.zeros(nx, ntheta * m)
+    Sc = ca.DM.zeros(nx, width * m)
+    xj, Sxs, Sts, Scs = [], [], [], []
+    for j in range(K):
+        Bj = ca.DM(nU, 0) if win is None else win.basis[j]
+        x, Sx, St, Sc = prop(x, Uj[j], Bj, p0, ca.vec(S), theta, tj[j], hj[j], Sx, St, Sc)
+        xj.append(x)
+        Sxs.append(Sx)
+        Sts.append(St)
+        Scs.append(Sc)
+    # constraints: node to node, like one-step shooting on the nodes
+    jac_theta = -_rows_of_blocks(St, nx, ntheta, m - 1, cols, ntheta_all)
+    jac_w = _bidiagonal(nx, m, -_transposed_blocks(Sx, nx, nx, m - 1), fixed_start=fixed)
+    jac_c = None
+    if win is not None:
+        # row k nx + i, column start_k + j: entry (i, k width + j) of the last step's Sc
+        kk, ii, jj = win.entries(m - 1, nx)
+        jac_c = scatter(-ca.vec(Sc), (nx * (m - 1), win.n_coefficients), kk * nx + ii,
+                        win.start[kk] + jj, (kk * width + jj) * nx + ii)
+    sens = StepSensitivities(K, m, n, fixed, N, tuple(xj), tuple(Sxs), tuple(Sts),
+                             tuple(Scs), win, cols)
+    return Block(ca.vec(W), w0.ravel(order="F"), g, X, jac_theta, jac_w, g_fast, jac_c,
+                 continuity(xj[-1]), state_jacobian=sens, X_fast=X_fast)
+
+
+def _dynamic_parameters(p: ca.MX, theta: ca.MX):
+    """``(p0, S, columns, theta[columns])`` with ``p = p0 + S theta[columns]``: only the
+    estimates that enter the model's parameters (a transducer offset, drift or stream lag
+    does not enter the dynamics, and forward sensitivities to it would be zeros carried
+    at full cost: the six-axis fit's 19 estimates hold 7 such)."""
+    p0, S = affine_parameters(p, theta)
+    Sn = np.asarray(ca.DM(S))
+    cols = np.flatnonzero(np.any(Sn != 0, axis=0))
+    return p0, ca.DM(Sn[:, cols]), cols, theta[cols.tolist()]
+
+
+def _rows_of_blocks(M: ca.MX, rows: int, cols: int, blocks: int, columns: np.ndarray,
+                    width: int) -> ca.MX:
+    """The first ``blocks`` of the ``rows x cols`` blocks side by side in ``M``, stacked
+    vertically, its columns placed at ``columns`` of ``width``."""
+    k, r, c = np.meshgrid(np.arange(blocks), np.arange(rows), np.arange(cols), indexing="ij")
+    return scatter(ca.vec(M), (rows * blocks, width), (k * rows + r).ravel(),
+                   np.asarray(columns)[c.ravel()], ((k * cols + c) * rows + r).ravel())
+
+
+def _transposed_blocks(M: ca.MX, rows: int, cols: int, blocks: int) -> ca.MX:
+    """The first ``blocks`` of the ``rows x cols`` blocks side by side in ``M``, each
+    transposed, side by side (``cols x rows blocks``)."""
+    k, r, c = np.meshgrid(np.arange(blocks), np.arange(rows), np.arange(cols), indexing="ij")
+    return scatter(ca.vec(M), (cols, rows * blocks), c.ravel(), (k * rows + r).ravel(),
+                   ((k * cols + c) * rows + r).ravel())
+
+
+class _Windows:
+    """The coefficients of an estimated input that each interval's stage inputs depend
+    on: a window of ``width`` consecutive coefficients from ``start[k]`` (the same width
+    for every interval, so one mapped function serves them), the inputs' dense basis over
+    it (``basis[j]``: step ``j``'s ``nU x width`` blocks of every interval side by side),
+    and ``first``/``last``, the window columns each interval really uses."""
+
+    def __init__(self, start, width, first, last, basis, n_coefficients):
+        self.start, self.width, self.first, self.last = start, width, first, last
+        self.basis, self.n_coefficients = basis, n_coefficients
+
+    @classmethod
+    def of(cls, A: ca.DM, m: int, nU: int, K: int) -> "_Windows":
+        """Windows of the ``m`` intervals of ``K`` steps of ``nU`` stage inputs each,
+        ``vec(U) = A c`` (``A``'s rows past its end: the padded steps, zero)."""
+        from ._sparse import scipy_csc
+
+        C = scipy_csc(A).tocsr().tocoo()  # entries in row order: intervals ascending
+        nc = C.shape[1]
+        k = C.row // (nU * K)
+        lo = np.zeros(m, dtype=np.int64)
+        hi = np.zeros(m, dtype=np.int64)
+        if k.size:
+            present, first = np.unique(k, return_index=True)
+            lo[present] = np.minimum.reduceat(C.col, first)
+            hi[present] = np.maximum.reduceat(C.col, first)
+        # a multiple of 4: fewer distinct compiled functions over records (zero columns)
+        width = int(min(nc, -(-int((hi - lo).max() + 1) // 4) * 4))
+        start = np.clip(lo, 0, nc - width)
+        # per step j: the (nU x width) bases of every interval side by side
+        L = np.zeros((K, nU, m, width))
+        r = C.row % (nU * K)
+        L[r // nU, r % nU, k, C.col - start[k]] = C.data
+        basis = [ca.DM(L[j].reshape(nU, m * width)) for j in range(K)]
+        return cls(start, width, lo - start, hi - start, basis, nc)
+
+    def grid_bases(self, A_grid: ca.DM, nu: int, K: int, n: int):
+        """The grid inputs' bases over the windows: per step ``j``, the ``nu x width``
+        blocks of sample ``k K + j + 1`` of every interval ``k`` side by side, and sample
+        0's (interval 0's window). A grid input outside its interval's window is an
+        error (the windows are the stage inputs', whose first and last stage times are
+        the samples)."""
+        from ._sparse import scipy_csc
+
+        C = scipy_csc(A_grid).tocoo()
+        m = self.start.size
+        s = C.row // nu
+        k = np.where(s > 0, (s - 1) // K, 0)
+        c = C.col - self.start[k]
+        if np.any((c < 0) | (c >= self.width)):
+            raise ValueError("a grid input depends on a carriage coefficient outside its "
+                             "interval's window")
+        L = np.zeros((K + 1, nu, m, self.width))  # index K: sample 0
+        j = np.where(s > 0, (s - 1) % K, K)
+        L[j, C.row % nu, k, c] = C.data
+        steps = [ca.DM(L[i].reshape(nu, m * self.width)) for i in range(K)]
+        return steps, ca.DM(L[K, :, 0, :])
+
+    def entries(self, intervals: int, per: int):
+        """``(k, i, j)`` index arrays over intervals ``k < intervals``, ``i < per`` and the
+        window columns ``j`` interval ``k`` uses."""
+        K_, I_, J_ = np.meshgrid(np.arange(intervals), np.arange(per), np.arange(self.width),
+                                 indexing="ij")
+        keep = (J_ >= self.first[K_]) & (J_ <= self.last[K_])
+        return K_[keep], I_[keep], J_[keep]
+
+
+@dataclass(frozen=True)
+class StepSensitivities:
+    """What a condensed block carries to the residual Jacobian: its layout (``K`` steps
+    per interval, ``m`` intervals, ``n`` samples, whether node 0 is fixed), the nodes
+    ``N`` (``nx x m``), and per step ``j`` of every interval (blocks side by side, one per
+    interval) the states after it and their sensitivities to the node (``nx x nx``), the
+    scaled parameters (``nx x ntheta``) and the window of carriage coefficients
+    (``nx x width``; :class:`_Windows`, ``None`` when the inputs are data)."""
+
+    K: int
+    m: int
+    n: int
+    fixed: bool
+    N: ca.MX
+    states: tuple
+    Sx: tuple
+    St: tuple
+    Sc: tuple
+    windows: "_Windows | None"
+    #: The estimates the sensitivities ``St`` are taken to (those entering the model's
+    #: parameters), as indices among all of them.
+    theta_columns: np.ndarray
+
+
+def _output_sensitivity(dm: DerivedModel, channels: tuple[str, ...], ntheta: int,
+                        width: int, compiled: bool) -> ca.Function:
+    """``(x, u, Bg, p0, vec(S), theta, t, Sx, St, Sc) -> (dy/dnode, dy/dtheta, dy/dc)`` of
+    the measured outputs ``y(x, u, p, t)`` (one row per channel) at a state with
+    sensitivities ``Sx, St, Sc`` and grid inputs ``u = Bg c`` over the window."""
+    key = ("condensed_output", channels, ntheta, width, compiled)
+
+    def build() -> ca.Function:
+        from derive import OUTPUT_NAMES
+
+        npar, nx, nu = len(dm.parameter_names), dm.nx, dm.nu
+        x = ca.SX.sym("x", nx)
+        u = ca.SX.sym("u", nu)
+        Bg = ca.SX.sym("Bg", nu, width)
+        p0 = ca.SX.sym("p0", npar)
+        Sv = ca.SX.sym("S", npar * ntheta)
+        th = ca.SX.sym("theta", ntheta)
+        t = ca.SX.sym("t")
+        Sx = ca.SX.sym("Sx", nx, nx)
+        St = ca.SX.sym("St", nx, ntheta)
+        Sc = ca.SX.sym("Sc", nx, width)
+        out = dm.outputs(x, u, p0 + ca.mtimes(ca.reshape(Sv, npar, ntheta), th), t)
+        y = ca.vertcat(*[out[OUTPUT_NAMES.index(c)] for c in channels])
+        Hx = ca.jacobian(y, x)
+        outs = [ca.densify(ca.mtimes(Hx, Sx)), ca.densify(ca.mtimes(Hx, St) + ca.jacobian(y, th)),
+                ca.densify(ca.mtimes(Hx, Sc) + ca.jtimes(y, u, Bg)) if width
+                else ca.SX(len(channels), 0)]
+        fn = ca.Function("condensed_output", [x, u, Bg, p0, Sv, th, t, Sx, St, Sc], outs)
+        if compiled:
+            fn = compile_fn(fn)
+        return fn
+
+    return dm.memo(key, build)
+
+
+def residual_jacobian(dm: DerivedModel, channels: tuple[str, ...], sens: StepSensitivities,
+                      Ug: ca.MX | ca.DM, p: ca.MX, theta: ca.MX, t: np.ndarray,
+                      factor: np.ndarray, compiled: bool, A_grid: ca.DM | None = None
+                      ) -> tuple[ca.MX, ca.MX, ca.MX | None]:
+    """``(d e/d theta, d e/d w, d e/d c)`` of ``e = vec(Y) * factor`` (``Y`` the measured
+    outputs, samples x channels, channel-major as
+    :func:`estimate.fitting.residual_jacobian.force_residual_jacobian`) on a condensed
+    block: each sample's output Jacobian composed with its state's sensitivities inside
+    one compiled per-sample function (no sparse products at evaluation)."""
+    K, m, n, nx, nu, nch = sens.K, sens.m, sens.n, dm.nx, dm.nu, len(channels)
+    ntheta_all = theta.numel()
+    win = sens.windows
+    width = 0 if win is None else win.width
+    p0, S, columns, theta = _dynamic_parameters(p, theta)
+    ntheta = len(columns)
+    fn = _output_sensitivity(dm, channels, ntheta, width, compiled)
+    fmap = dm.mapped(("condensed_output", channels, ntheta, width, compiled), fn, m)
+    pad = m * K + 1 - n
+    Ugp = ca.horzcat(Ug, ca.DM.zeros(nu, pad)) if pad else Ug
+    tp = np.r_[t, np.full(pad, t[-1])]
+    bases = (None if win is None else
+             win.grid_bases(A_grid, nu, K, n))  # step j's (nu x width m), sample 0's
+    outs = []
+    for j in range(K):
+        Bg = ca.DM(nu, 0) if win is None else bases[0][j]
+        outs.append(fmap(sens.states[j], Ugp[:, j + 1::K], Bg, p0, ca.vec(S), theta,
+                         ca.DM(tp[j + 1::K]).T, sens.Sx[j], sens.St[j], sens.Sc[j]))
+    # sample 0: at node 0, whose sensitivities are the identity and zeros
+    Bg0 = ca.DM(nu, 0) if win is None else bases[1]
+    outs.append(fn(sens.N[:, 0], Ug[:, 0], Bg0, p0, ca.vec(S), theta, float(t[0]),
+                   ca.DM.eye(nx), ca.DM.zeros(nx, ntheta), ca.DM.zeros(nx, width)))
+    factor = np.asarray(factor, float)
+    # sample s = k K + j + 1 of step j, interval k (padded samples s >= n dropped); the
+    # last entry of every block list is sample 0's (interval 0, "step -1")
+
+    def block(idx: int, width_b: int, col_of, keep_col=None):
+        rows, cols, src, off = [], [], [], 0
+        for j in range(K + 1):
+            count = m if j < K else 1
+            k_, ch_, c_ = np.meshgrid(np.arange(count), np.arange(nch), np.arange(width_b),
+                                      indexing="ij")
+            smp = k_ * K + j + 1 if j < K else np.zeros_like(k_)
+            keep = smp < n
+            if keep_col is not None:
+                keep &= keep_col(k_, c_)
+            rows.append((ch_ * n + smp)[keep])
+            cols.append(col_of(k_, c_)[keep])
+            src.append((off + (k_ * width_b + c_) * nch + ch_)[keep])
+            off += count * width_b * nch
+        rows, cols, src = np.concatenate(rows), np.concatenate(cols), np.concatenate(src)
+        values = ca.vertcat(*[ca.vec(o[idx]) for o in outs])
+        scale = np.zeros(off)
+        scale[src] = factor[rows]
+        return rows, cols, src, values * ca.DM(scale)
+
+    rows, cols, src, v = block(1, ntheta, lambda k_, c_: columns[c_])
+    J_theta = scatter(v, (nch * n, ntheta_all), rows, cols, src)
+    offn = -1 if sens.fixed else 0
+    nvar = nx * (m + offn)
+    rows, cols, src, v = block(0, nx, lambda k_, c_: (k_ + offn) * nx + c_,
+                               lambda k_, c_: k_ + offn >= 0)
+    J_states = scatter(v, (nch * n, nvar), rows, cols, src)
+    J_c = None
+    if win is not None:
+        rows, cols, src, v = block(2, width, lambda k_, c_: win.start[k_] + c_,
+                                   lambda k_, c_: (c_ >= win.first[k_]) & (c_ <= win.last[k_]))
+        J_c = scatter(v, (nch * n, win.n_coefficients), rows, cols, src)
+    return J_theta, J_states, J_c
