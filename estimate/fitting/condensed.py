@@ -48,6 +48,19 @@ def padded_grid(t: np.ndarray, K: int) -> tuple[int, np.ndarray, np.ndarray]:
     return m, tk, hk
 
 
+def _sensitivity_symbols(dm: DerivedModel, ntheta: int, width: int):
+    """The symbolic inputs both per-step functions share: ``p0, vec(S), theta`` (and
+    ``p = p0 + S theta``) and a state's sensitivities ``Sx, St, Sc`` to the node, the
+    estimates and a window of ``width`` coefficients."""
+    npar, nx = len(dm.parameter_names), dm.nx
+    p0 = ca.SX.sym("p0", npar)
+    Sv = ca.SX.sym("S", npar * ntheta)
+    th = ca.SX.sym("theta", ntheta)
+    p = p0 + ca.mtimes(ca.reshape(Sv, npar, ntheta), th)
+    return (p0, Sv, th), p, (ca.SX.sym("Sx", nx, nx), ca.SX.sym("St", nx, ntheta),
+                             ca.SX.sym("Sc", nx, width))
+
+
 def _propagation(dm: DerivedModel, substeps: int, ntheta: int, width: int,
                  compiled: bool) -> ca.Function:
     """One RK4 step carrying forward sensitivities: ``(x, U, B, p0, vec(S), theta, t, h,
@@ -61,18 +74,12 @@ def _propagation(dm: DerivedModel, substeps: int, ntheta: int, width: int,
     def build() -> ca.Function:
         step = rk4_step(dm, substeps)
         nU, nx = step.size1_in(1), dm.nx
-        npar = len(dm.parameter_names)
         x = ca.SX.sym("x", nx)
         U = ca.SX.sym("U", nU)
         B = ca.SX.sym("B", nU, width)
-        p0 = ca.SX.sym("p0", npar)
-        Sv = ca.SX.sym("S", npar * ntheta)
-        th = ca.SX.sym("theta", ntheta)
         t, h = ca.SX.sym("t"), ca.SX.sym("h")
-        Sx = ca.SX.sym("Sx", nx, nx)
-        St = ca.SX.sym("St", nx, ntheta)
-        Sc = ca.SX.sym("Sc", nx, width)
-        xn = step(x, U, p0 + ca.mtimes(ca.reshape(Sv, npar, ntheta), th), t, h)
+        (p0, Sv, th), p, (Sx, St, Sc) = _sensitivity_symbols(dm, ntheta, width)
+        xn = step(x, U, p, t, h)
         A = ca.jacobian(xn, x)
         outs = [xn, ca.densify(ca.mtimes(A, Sx)),
                 ca.densify(ca.mtimes(A, St) + ca.jacobian(xn, th)),
@@ -171,7 +178,7 @@ def condensed_block(dm: DerivedModel, substeps: int, K: int, p: ca.MX, t: np.nda
         jac_c = scatter(-ca.vec(Sc), (nx * (m - 1), win.n_coefficients), kk * nx + ii,
                         win.start[kk] + jj, (kk * width + jj) * nx + ii)
     sens = StepSensitivities(K, m, n, fixed, N, tuple(xj), tuple(Sxs), tuple(Sts),
-                             tuple(Scs), win, cols)
+                             tuple(Scs), win, cols, p0, S, theta)
     return Block(ca.vec(W), w0.ravel(order="F"), g, X, jac_theta, jac_w, g_fast, jac_c,
                  continuity(xj[-1]), state_jacobian=sens, X_fast=X_fast)
 
@@ -291,8 +298,12 @@ class StepSensitivities:
     Sc: tuple
     windows: "_Windows | None"
     #: The estimates the sensitivities ``St`` are taken to (those entering the model's
-    #: parameters), as indices among all of them.
+    #: parameters), as indices among all of them, and the model's parameters as
+    #: ``p0 + S theta`` of those estimates (:func:`_dynamic_parameters`).
     theta_columns: np.ndarray
+    p0: ca.DM
+    S: ca.DM
+    theta: ca.MX
 
 
 def _output_sensitivity(dm: DerivedModel, channels: tuple[str, ...], ntheta: int,
@@ -305,18 +316,12 @@ def _output_sensitivity(dm: DerivedModel, channels: tuple[str, ...], ntheta: int
     def build() -> ca.Function:
         from derive import OUTPUT_NAMES
 
-        npar, nx, nu = len(dm.parameter_names), dm.nx, dm.nu
-        x = ca.SX.sym("x", nx)
-        u = ca.SX.sym("u", nu)
-        Bg = ca.SX.sym("Bg", nu, width)
-        p0 = ca.SX.sym("p0", npar)
-        Sv = ca.SX.sym("S", npar * ntheta)
-        th = ca.SX.sym("theta", ntheta)
+        x = ca.SX.sym("x", dm.nx)
+        u = ca.SX.sym("u", dm.nu)
+        Bg = ca.SX.sym("Bg", dm.nu, width)
         t = ca.SX.sym("t")
-        Sx = ca.SX.sym("Sx", nx, nx)
-        St = ca.SX.sym("St", nx, ntheta)
-        Sc = ca.SX.sym("Sc", nx, width)
-        out = dm.outputs(x, u, p0 + ca.mtimes(ca.reshape(Sv, npar, ntheta), th), t)
+        (p0, Sv, th), p, (Sx, St, Sc) = _sensitivity_symbols(dm, ntheta, width)
+        out = dm.outputs(x, u, p, t)
         y = ca.vertcat(*[out[OUTPUT_NAMES.index(c)] for c in channels])
         Hx = ca.jacobian(y, x)
         outs = [ca.densify(ca.mtimes(Hx, Sx)), ca.densify(ca.mtimes(Hx, St) + ca.jacobian(y, th)),
@@ -331,19 +336,19 @@ def _output_sensitivity(dm: DerivedModel, channels: tuple[str, ...], ntheta: int
 
 
 def residual_jacobian(dm: DerivedModel, channels: tuple[str, ...], sens: StepSensitivities,
-                      Ug: ca.MX | ca.DM, p: ca.MX, theta: ca.MX, t: np.ndarray,
-                      factor: np.ndarray, compiled: bool, A_grid: ca.DM | None = None
+                      Ug: ca.MX | ca.DM, ntheta_all: int, t: np.ndarray, factor: np.ndarray,
+                      compiled: bool, A_grid: ca.DM | None = None
                       ) -> tuple[ca.MX, ca.MX, ca.MX | None]:
-    """``(d e/d theta, d e/d w, d e/d c)`` of ``e = vec(Y) * factor`` (``Y`` the measured
-    outputs, samples x channels, channel-major as
+    """``(d e/d theta, d e/d w, d e/d c)`` of ``e = vec(Y) * factor`` w.r.t. the
+    ``ntheta_all`` scaled estimates, the block's nodes and the carriage coefficients
+    (``Y`` the measured outputs, samples x channels, channel-major as
     :func:`estimate.fitting.residual_jacobian.force_residual_jacobian`) on a condensed
     block: each sample's output Jacobian composed with its state's sensitivities inside
     one compiled per-sample function (no sparse products at evaluation)."""
     K, m, n, nx, nu, nch = sens.K, sens.m, sens.n, dm.nx, dm.nu, len(channels)
-    ntheta_all = theta.numel()
     win = sens.windows
     width = 0 if win is None else win.width
-    p0, S, columns, theta = _dynamic_parameters(p, theta)
+    p0, S, columns, theta = sens.p0, sens.S, sens.theta_columns, sens.theta
     ntheta = len(columns)
     fn = _output_sensitivity(dm, channels, ntheta, width, compiled)
     fmap = dm.mapped(("condensed_output", channels, ntheta, width, compiled), fn, m)

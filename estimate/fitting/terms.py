@@ -225,8 +225,8 @@ def case_terms(problem: FitProblem, i: int, theta_s: ca.MX, transcription: Trans
         if block.state_jacobian is not None:  # states simulated from coarser nodes
             from .condensed import residual_jacobian
 
-            jt, jx, jc = residual_jacobian(dm, chans, block.state_jacobian, Ug, p_i, theta_s,
-                                           t, factor, compile_,
+            jt, jx, jc = residual_jacobian(dm, chans, block.state_jacobian, Ug,
+                                           theta_s.numel(), t, factor, compile_,
                                            None if carriage is None else A_grid)
         else:
             jt, jx, jc = force_residual_jacobian(
