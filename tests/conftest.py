@@ -37,3 +37,18 @@ def _private_cache(tmp_path_factory):
     if "SLOSH_CACHE_DIR" not in os.environ or os.environ.get("SLOSH_TEST_KEEP_CACHE") != "1":
         os.environ["SLOSH_CACHE_DIR"] = str(tmp_path_factory.mktemp("slosh-cache"))
     yield
+
+
+@pytest.fixture(autouse=True)
+def _python_sigint():
+    """Every test runs with Python's own SIGINT handler (KeyboardInterrupt), which child
+    processes inherit as "not ignored". A test run started in the background of a
+    non-interactive shell (``pytest &``, some CI runners) inherits SIGINT ignored; the
+    tests that interrupt themselves or a child then failed, or not, depending on whether an
+    earlier test in the same worker had put Python's handler back (a notebook's kernel
+    client does)."""
+    import signal
+
+    previous = signal.signal(signal.SIGINT, signal.default_int_handler)
+    yield
+    signal.signal(signal.SIGINT, previous)

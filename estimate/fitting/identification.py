@@ -9,14 +9,16 @@ frequency ``omega``, damping ratio ``zeta``) driven by the carriage acceleration
 (``b`` is the acceleration of the mode's bob; ``tau`` the lag of the force stream behind the
 motion stream). For given ``(omega, zeta, tau)`` the force is linear in ``(M, m)`` and an
 offset, so those follow by linear least squares (variable projection) and only the three
-nonlinear parameters are searched, by SciPy's ``least_squares`` from a few starts: the
-predicted frequency and the force spectrum's peaks around it, each with the lag where the
-objective's profile over a grid is lowest. The best start is kept; starts that end in other
+nonlinear parameters are searched, by SciPy's ``least_squares`` (with the projected
+residual's exact Jacobian) from a few starts: the predicted frequency, the force
+spectrum's peaks around it and the lowest physical point of the objective's profile over
+frequency and damping, each with the lag where the objective's profile over a grid is
+lowest. The best start is kept; starts that end in other
 minima are reported with their spread. The acceleration is the least-squares spline through
 the measured displacement (the estimated input's start, :mod:`estimate.fitting.carriage`) or
-the filtered input; the mode's response is the exact discretisation of ``B/A`` for a
-piecewise-linear acceleration (``scipy.signal.cont2discrete``, first-order hold) filtered
-over the record (``scipy.signal.lfilter``), from rest.
+the filtered input; the mode's response is ``B/A`` discretised by the bilinear transform
+prewarped at the mode's frequency, filtered over the record (``scipy.signal.lfilter``),
+from rest.
 
 The result starts the NLP (masses, length, hinge damping, the rigid mass of an unweighed
 container, the stream lag) and decides whether the lag is identifiable.
@@ -36,10 +38,13 @@ from .first_stage_model import (
     LOWPASS_MIN_HZ,
     _beta_covariance,
     _finite,
+    _frequency_profile,
     _lag_profile,
     _physical,
     _prepared,
     _projected,
+    _projected_jacobian,
+    _Projection,
     _stacked,
     _swing,
 )
@@ -238,22 +243,26 @@ def identify(records, *, frequency_hz: float, gravity: float | None = None,
     if all(not np.any(np.abs(r.acceleration(r.time)) > 0) for r in recs):
         return None
     top_hz = min(0.25 * fs, 0.5 * cutoff)
+    profiled = _frequency_profile(recs, max(lo, min_hz), min(hi, top_hz))
+    if profiled is not None and all(abs(profiled / s - 1) > SPREAD_RELATIVE for s in starts):
+        starts.append(profiled)
     n = len(recs)
     lo = np.r_[math.log(2 * math.pi * min_hz), math.log(ZETA_RANGE[0]), [LAG_RANGE[0]] * n]
     hi = np.r_[math.log(2 * math.pi * top_hz), math.log(ZETA_RANGE[1]), [LAG_RANGE[1]] * n]
     x_scale = np.r_[0.05, 0.5, [0.005] * n]
 
     def search(x0):
-        return least_squares(lambda x: _projected(recs, x)[0], x0, bounds=(lo, hi),
-                             x_scale=x_scale, method="trf", xtol=1e-4, ftol=1e-6,
-                             max_nfev=60)
+        f = _Projection(recs, x0, range(2 + n))
+        return least_squares(f.residual, x0, jac=f.jacobian, bounds=(lo, hi), x_scale=x_scale,
+                             method="trf", xtol=1e-4, ftol=1e-6, max_nfev=60)
 
     def search_without_lag(x0):
         # the mode alone, the streams taken as synchronous: a steady drive trades a free
         # lag for the mode's phase, and the data then prefer neither clearly
-        sol = least_squares(lambda y: _projected(recs, np.r_[y, x0[2:]])[0], x0[:2],
-                            bounds=(lo[:2], hi[:2]), x_scale=x_scale[:2], method="trf",
-                            xtol=1e-4, ftol=1e-6, max_nfev=60)
+        f = _Projection(recs, x0, range(2))
+        sol = least_squares(f.residual, x0[:2], jac=f.jacobian, bounds=(lo[:2], hi[:2]),
+                            x_scale=x_scale[:2], method="trf", xtol=1e-4, ftol=1e-6,
+                            max_nfev=60)
         sol.x = np.r_[sol.x, x0[2:]]
         sol.jac = np.hstack([sol.jac, np.zeros((sol.jac.shape[0], n))])
         return sol
@@ -261,11 +270,11 @@ def identify(records, *, frequency_hz: float, gravity: float | None = None,
     outcomes = []
     for f0 in starts:  # the linear mode from every start: cheap, and no start is needed
         x0 = np.r_[math.log(2 * math.pi * f0), math.log(0.01), np.zeros(n)]
-        for sol in (search_without_lag(x0), None):
-            if sol is None:
-                x0[2:] = _lag_profile(recs, x0)
-                sol = search(x0)
-            outcomes.append((float(2 * sol.cost), f0, sol))
+        outcomes.append(search_without_lag(x0))
+        x0[2:] = _lag_profile(recs, x0)
+        outcomes.append(search(x0))
+    outcomes = [(float(2 * sol.cost), f0, sol) for f0, sol in
+                zip(np.repeat(starts, 2), outcomes)]
     # the best physical outcome (positive masses, lags inside the range) first
     outcomes.sort(key=lambda o: (not _physical(recs, o[2].x), o[0]))
     best_cost, _, best = outcomes[0]
@@ -273,10 +282,7 @@ def identify(records, *, frequency_hz: float, gravity: float | None = None,
     F_all = _stacked(recs, best.x)[1]
     n_obs = r.size
     s2 = best_cost / max(n_obs - (2 + n + 3 * n), 1)
-    J = best.jac
-    if not np.any(J[:, 2:]):  # the lag was held: its sensitivity there, all free
-        J = least_squares(lambda x: _projected(recs, x)[0], best.x, bounds=(lo, hi),
-                          x_scale=x_scale, max_nfev=1).jac
+    J = _projected_jacobian(recs, best.x)
     cov_x = s2 * np.linalg.pinv(J.T @ J)
     se_x = np.sqrt(np.clip(np.diag(cov_x), 0, None))
     info = J.T @ J

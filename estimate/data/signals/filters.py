@@ -59,7 +59,7 @@ def _extend(t: NDArray[np.float64], x: NDArray[np.float64], step: float, pad_sec
     n_win = min(n, max(int(round(1.0 * fs)), 16))
     # two periods of the record's dominant frequency when that is longer than 1 s
     try:
-        f_dom = dominant_frequency(t, x, min_frequency=2.0 / (t[-1] - t[0]))
+        f_dom = dominant_frequency(t, x, min_frequency=2.0 / (t[-1] - t[0]), refine=False)
         n_win = min(n, max(n_win, int(round(2.0 * fs / f_dom))))
     except ValueError:
         pass

@@ -174,8 +174,9 @@ def find_spectral_peaks(time: ArrayLike, values: ArrayLike, *, min_frequency: fl
 
 
 def dominant_frequency(time: ArrayLike, values: ArrayLike, *, min_frequency: float = 0.1,
-                       max_frequency: float | None = None) -> float:
-    """Frequency of the strongest spectral peak [Hz], refined (see :func:`find_spectral_peaks`).
+                       max_frequency: float | None = None, refine: bool = True) -> float:
+    """Frequency of the strongest spectral peak [Hz], refined by a sinusoid fit unless
+    ``refine`` is false (then to the spectrum's resolution; see :func:`find_spectral_peaks`).
 
     Raises
     ------
@@ -191,7 +192,7 @@ def dominant_frequency(time: ArrayLike, values: ArrayLike, *, min_frequency: flo
     2.1
     """
     peaks = find_spectral_peaks(time, values, min_frequency=min_frequency,
-                                max_frequency=max_frequency, max_peaks=1)
+                                max_frequency=max_frequency, max_peaks=1, refine=refine)
     if not peaks:
         band = f"{min_frequency:g} Hz to " + ("Nyquist" if max_frequency is None
                                               else f"{max_frequency:g} Hz")
