@@ -126,15 +126,6 @@ def _coefficients(omega, zeta, dt: float):
     return num, den, (d_num_omega, d_den_omega), (d_num_zeta, d_den_zeta)
 
 
-def _bob_acceleration(a: np.ndarray, dt: float, omega: float, zeta: float) -> np.ndarray:
-    """The linear mode's bob acceleration for the acceleration samples ``a`` (m/s^2), from
-    rest: :func:`_coefficients`' filter over the record (``scipy.signal.lfilter``)."""
-    from scipy.signal import lfilter
-
-    num, den, _, _ = _coefficients(omega, zeta, dt)
-    return lfilter(num, den, a - a[0]) + a[0]
-
-
 def _design(rec: _Record, omega: float, zeta: float, lag: float, derivatives: bool = False):
     """Columns ``[a(t - lag), b(t - lag), 1]`` of one record (``b`` of the linear mode) and,
     with ``derivatives``, those of ``b`` by log omega and log zeta and of ``[a, b]`` by the
@@ -216,8 +207,7 @@ def _projected(recs, x) -> tuple[np.ndarray, np.ndarray]:
 
 
 def _projected_jacobian(recs, x) -> np.ndarray:
-    """The exact Jacobian of :func:`_projected`'s residual by ``x`` (Golub-Pereyra):
-    ``dr/dx_k = -(I - X X^+) dX_k beta - X (X^T X)^-1 dX_k^T r``."""
+    """The exact Jacobian of :func:`_projected`'s residual by ``x`` (:class:`_Projection`)."""
     return _Projection(recs, x, range(len(x))).jacobian(x)
 
 
