@@ -24,7 +24,7 @@ from pathlib import Path
 
 import casadi as ca
 
-from .cache import UntrustedCache, cache_folder, file_problem
+from .cache import UntrustedCache, building, cache_folder, file_problem
 
 __all__ = ["compiled", "c_compiler"]
 
@@ -71,30 +71,31 @@ def compiled(fn: ca.Function) -> ca.Function:
         return _LOADED[key]
     folder = cache_folder("compiled")
     lib = folder / f"{fn.name()}_{key}.so"
-    if not _trusted(lib):
-        cc = c_compiler()
-        if cc is None:
-            warnings.warn("no C compiler found: using CasADi's virtual machine", RuntimeWarning,
-                          stacklevel=3)
-            return fn
-        with tempfile.TemporaryDirectory(dir=folder) as tmp:
-            src = f"{fn.name()}_{key}.c"
-            gen = ca.CodeGenerator(src, {"with_header": False})
-            gen.add(fn)
-            gen.generate(tmp + os.sep)
-            out = Path(tmp) / lib.name
-            proc = subprocess.run([cc, "-O2", "-shared", "-fPIC", "-o", str(out), str(Path(tmp) / src)],
-                                  capture_output=True, text=True)
-            if proc.returncode != 0:
-                warnings.warn(f"compiling {fn.name()} failed, using CasADi's virtual machine:\n"
-                              f"{proc.stderr[-2000:]}", RuntimeWarning, stacklevel=3)
+    with building(lib):  # another process compiling the same function: wait for it
+        if not _trusted(lib):
+            cc = c_compiler()
+            if cc is None:
+                warnings.warn("no C compiler found: using CasADi's virtual machine", RuntimeWarning,
+                              stacklevel=3)
                 return fn
-            stamp = Path(tmp) / (lib.name + ".sha256")
-            stamp.write_text(_file_digest(out))
-            # the library first, then its hash: a reader between the two sees a mismatch
-            # and rebuilds instead of loading a library without a matching hash
-            os.replace(out, lib)
-            os.replace(stamp, lib.with_name(lib.name + ".sha256"))
+            with tempfile.TemporaryDirectory(dir=folder) as tmp:
+                src = f"{fn.name()}_{key}.c"
+                gen = ca.CodeGenerator(src, {"with_header": False})
+                gen.add(fn)
+                gen.generate(tmp + os.sep)
+                out = Path(tmp) / lib.name
+                proc = subprocess.run([cc, "-O2", "-shared", "-fPIC", "-o", str(out), str(Path(tmp) / src)],
+                                      capture_output=True, text=True)
+                if proc.returncode != 0:
+                    warnings.warn(f"compiling {fn.name()} failed, using CasADi's virtual machine:\n"
+                                  f"{proc.stderr[-2000:]}", RuntimeWarning, stacklevel=3)
+                    return fn
+                stamp = Path(tmp) / (lib.name + ".sha256")
+                stamp.write_text(_file_digest(out))
+                # the library first, then its hash: a reader between the two sees a mismatch
+                # and rebuilds instead of loading a library without a matching hash
+                os.replace(out, lib)
+                os.replace(stamp, lib.with_name(lib.name + ".sha256"))
     ext = ca.external(fn.name(), str(lib))
     _LOADED[key] = ext
     return ext

@@ -2,6 +2,7 @@
 
 from __future__ import annotations
 
+import contextlib
 import threading
 import warnings
 
@@ -49,27 +50,30 @@ def derive(model: Model, *, use_cache: bool = True) -> DerivedModel:
     if live is not None:
         fns, meta, memo = live
         return _derived_model(model, fns, meta, memo, from_cache=True)
-    hit = cache.load(key) if key is not None else None
-    if hit is not None:
-        fns, meta = hit
-        from_cache = True
-    else:
-        from ._lagrange import assemble
-        from ._to_casadi import dependencies, to_casadi
+    lock = (cache.building(cache.cache_dir() / key) if key is not None
+            else contextlib.nullcontext())
+    with lock:  # another process deriving the same model: wait for its entry
+        hit = cache.load(key) if key is not None else None
+        if hit is not None:
+            fns, meta = hit
+            from_cache = True
+        else:
+            from ._lagrange import assemble
+            from ._to_casadi import dependencies, to_casadi
 
-        sym = assemble(model)
-        fns = to_casadi(sym)
-        meta = {
-            "coordinates": list(sym.coordinates),
-            "inputs": list(sym.inputs),
-            "input_units": list(sym.input_units),
-            "parameters": list(sym.parameters),
-            "measured": list(sym.measured),
-            "dependencies": dependencies(fns, sym.parameters),
-        }
-        if key is not None:
-            cache.store(key, fns, meta)
-        from_cache = False
+            sym = assemble(model)
+            fns = to_casadi(sym)
+            meta = {
+                "coordinates": list(sym.coordinates),
+                "inputs": list(sym.inputs),
+                "input_units": list(sym.input_units),
+                "parameters": list(sym.parameters),
+                "measured": list(sym.measured),
+                "dependencies": dependencies(fns, sym.parameters),
+            }
+            if key is not None:
+                cache.store(key, fns, meta)
+            from_cache = False
     memo: dict = {}
     if key is not None:
         _keep_live(key, fns, meta, memo)

@@ -22,7 +22,6 @@ from .derived import OUTPUT_NAMES
 __all__ = ["SymbolicModel", "assemble", "OUTPUT_NAMES"]
 
 
-
 @dataclass(frozen=True)
 class SymbolicModel:
     """Equations of a model with plain symbols in place of functions of time.
@@ -110,24 +109,16 @@ def assemble(model: Model) -> SymbolicModel:
 
     qf = [s for _, s in coords]
     n = len(qf)
-    if n:
-        lm = me.LagrangesMethod(kinetic - potential, qf)
-        lm.form_lagranges_equations()
-        M, f = lm.mass_matrix, lm.forcing
-        rayleigh = sp.Add(*collected.dissipation)
-        qdf = [s.diff(t) for s in qf]
-        extra = [-sp.diff(rayleigh, qd) for qd in qdf]
-        for coord, gen_force in collected.forces:
-            extra[qf.index(coord)] += gen_force
-        f = f + sp.Matrix(extra)
-    else:
-        M, f = sp.zeros(0, 0), sp.zeros(0, 1)
-
     q = tuple(sp.Symbol(f"q{i}", real=True) for i in range(n))
     qd = tuple(sp.Symbol(f"qd{i}", real=True) for i in range(n))
     qdd = tuple(sp.Symbol(f"qdd{i}", real=True) for i in range(n))
     inputs, units, usyms, rule = [], [], [], {}
+    # the time derivative of every plain symbol but qd: q -> qd, an input's derivative of
+    # order r -> the next, or the input declared as its derivative (a derivative no input
+    # supplies stays a Derivative, named below)
+    dot: dict = {}
     for j, (sig, name, unit, derivatives) in enumerate(shared.inputs):
+        orders = []
         for order, suffix, uunit in ((0, "", unit), (1, "_dot", f"{unit}/s"),
                                      (2, "_ddot", f"{unit}/s^2"))[:derivatives + 1]:
             sym = sp.Symbol(f"u{j}_{order}", real=True)
@@ -135,13 +126,39 @@ def assemble(model: Model) -> SymbolicModel:
             inputs.append(name + suffix)
             units.append(uunit)
             usyms.append(sym)
+            orders.append(sym)
+        for order, sym in enumerate(orders):
+            dot[sym] = orders[order + 1] if order + 1 < len(orders) else sig.diff(t, order + 1)
     for i, s in enumerate(qf):
         rule[s.diff(t, 2)] = qdd[i]
         rule[s.diff(t)] = qd[i]
         rule[s] = q[i]
+        dot[q[i]] = qd[i]
 
     def plain(e: sp.Expr) -> sp.Expr:
         return e.xreplace(rule)
+
+    # an input given as another's derivative (an angular acceleration beside the rate)
+    dot = {s: plain(ds) for s, ds in dot.items()}
+
+    if n:
+        # Lagrange's equations on plain symbols: with P = dL/dqd,
+        # d/dt P = (dP/dqd) qdd + sum over the other symbols s of (dP/ds) s' + dP/dt,
+        # so M = dP/dqd and f = dL/dq - (the rest) - dR/dqd + Q (SymPy's LagrangesMethod
+        # gives the same equations through substitutions that take minutes on a free bus)
+        lagrangian = plain(kinetic - potential)
+        P = [sp.diff(lagrangian, v) for v in qd]
+        M = sp.Matrix(n, n, lambda i, k: sp.diff(P[i], qd[k]))
+        rayleigh = plain(sp.Add(*collected.dissipation))
+        f = []
+        for i in range(n):
+            rest = sp.Add(*[sp.diff(P[i], s) * ds for s, ds in dot.items()]) + sp.diff(P[i], t)
+            f.append(sp.diff(lagrangian, q[i]) - rest - sp.diff(rayleigh, qd[i]))
+        for coord, gen_force in collected.forces:
+            f[qf.index(coord)] += plain(gen_force)
+        f = sp.Matrix(f)
+    else:
+        M, f = sp.zeros(0, 0), sp.zeros(0, 1)
 
     axes = T
     if shared.transducer is not None:  # measured about its point, in its own axes
@@ -153,7 +170,7 @@ def assemble(model: Model) -> SymbolicModel:
         plain(kinetic),
         plain(potential),
     )
-    M_plain, f_plain = M.applyfunc(plain), f.applyfunc(plain)
+    M_plain, f_plain = M, f
     left = set().union(*(e.atoms(sp.Derivative, AppliedUndef)
                          for e in (*M_plain, *f_plain, *outputs)))
     if left:

@@ -8,7 +8,9 @@ SymPy and CasADi versions. A model whose source cannot be read is derived withou
 Entries are JSON files holding serialized CasADi functions, metadata and a SHA-256 of both;
 a truncated, empty or altered entry fails the check and is rebuilt. Entries are written to a
 temporary file in the cache folder and renamed into place, so concurrent writers never leave
-a half-written entry. A cache hit imports no SymPy. The folder is ``$SLOSH_CACHE_DIR`` or
+a half-written entry, and a process about to derive or compile what another is deriving
+waits for it on a lock file (:func:`building`) and loads its result instead of repeating
+minutes of SymPy. A cache hit imports no SymPy. The folder is ``$SLOSH_CACHE_DIR`` or
 ``~/.cache/slosh-analogs``, created private to the user (mode 0700). It is used only while
 it, every folder below it on the way to an entry, and the entry itself belong to the user
 and nobody else can write to them (symlinks resolved; :mod:`derive._trust`); otherwise the
@@ -17,6 +19,7 @@ command says so once and caches in a private temporary folder for the run.
 
 from __future__ import annotations
 
+import contextlib
 import functools
 import hashlib
 import json
@@ -30,8 +33,8 @@ import casadi as ca
 
 from ._trust import UntrustedCache, file_problem, folder_problem, private_folder
 
-__all__ = ["UntrustedCache", "write_atomic", "cache_dir", "cache_key", "cache_folder", "configured_dir",
-           "ensure_private_dir", "file_problem", "load", "store"]
+__all__ = ["UntrustedCache", "building", "write_atomic", "cache_dir", "cache_key", "cache_folder",
+           "configured_dir", "ensure_private_dir", "file_problem", "load", "store"]
 
 _FUNCTIONS = ("rhs", "outputs", "mass_matrix", "forcing")
 
@@ -171,6 +174,26 @@ def write_atomic(path: str | os.PathLike[str], data: bytes | str, *,
         Path(tmp).unlink(missing_ok=True)
         raise
     return path
+
+
+@contextlib.contextmanager
+def building(path: str | os.PathLike[str]):
+    """Hold an exclusive lock on ``path`` + ``.lock`` while the block builds ``path``: a
+    second process building the same entry (two test workers, a campaign's workers)
+    waits, then finds it built. Without ``fcntl`` (Windows) there is no lock and both
+    build; the atomic writes keep the entry whole either way."""
+    try:
+        import fcntl
+    except ImportError:  # pragma: no cover - not POSIX
+        yield
+        return
+    lock = Path(f"{os.fspath(path)}.lock")
+    fd = os.open(lock, os.O_RDWR | os.O_CREAT, 0o600)
+    try:
+        fcntl.flock(fd, fcntl.LOCK_EX)
+        yield
+    finally:
+        os.close(fd)  # closing releases the lock
 
 
 def store(key: str, functions: dict[str, ca.Function], meta: dict) -> Path:

@@ -33,9 +33,17 @@ import pytest
 
 @pytest.fixture(scope="session", autouse=True)
 def _private_cache(tmp_path_factory):
-    """Derived models are cached in a folder of this test session, not in the user's home."""
+    """Derived models are cached in a folder of this test session, not in the user's home,
+    shared by the session's xdist workers: a model one worker is deriving (the spacecraft's
+    takes 40 s) is waited for by the other (:func:`derive.cache.building`), not derived
+    twice."""
     if "SLOSH_CACHE_DIR" not in os.environ or os.environ.get("SLOSH_TEST_KEEP_CACHE") != "1":
-        os.environ["SLOSH_CACHE_DIR"] = str(tmp_path_factory.mktemp("slosh-cache"))
+        root = tmp_path_factory.getbasetemp()
+        if os.environ.get("PYTEST_XDIST_WORKER"):
+            root = root.parent  # the session's folder, above each worker's own
+        folder = root / "slosh-cache"
+        folder.mkdir(mode=0o700, exist_ok=True)
+        os.environ["SLOSH_CACHE_DIR"] = str(folder)
     yield
 
 

@@ -37,6 +37,28 @@ def test_second_derive_in_a_new_process_loads_from_cache_without_sympy(tmp_path)
     assert runs[1] == {"cached": True, "sympy": False}
 
 
+def test_two_processes_deriving_one_model_at_once_derive_it_once(tmp_path):
+    # both wait for a go file, then derive at the same moment: without the lock both would
+    # run SymPy (both report cached False); with it the second waits and loads the entry
+    env = {**os.environ, "SLOSH_CACHE_DIR": str(tmp_path / "cache")}
+    go = tmp_path / "go"
+    script = (
+        "import json, time, pathlib\n"
+        "from analogs import FixedMass, HingeDamper, HingeSpring, LateralRig, Pendulum\n"
+        "from derive import derive\n"
+        "m = (LateralRig() + FixedMass('fixed') + Pendulum('p1') + HingeSpring('p1') + HingeDamper('p1')"
+        " + Pendulum('p2') + HingeDamper('p2'))\n"
+        f"while not pathlib.Path({str(go)!r}).exists(): time.sleep(0.01)\n"
+        "print(json.dumps(derive(m).from_cache))\n"
+    )
+    procs = [subprocess.Popen([sys.executable, "-c", script], env=env, cwd=ROOT, stdout=subprocess.PIPE,
+                              text=True) for _ in range(2)]
+    go.touch()
+    cached = sorted(json.loads(p.communicate(timeout=300)[0]) for p in procs)
+    assert [p.returncode for p in procs] == [0, 0]
+    assert cached == [False, True]
+
+
 def test_cached_model_evaluates_like_a_fresh_derivation():
     fresh = derive(_two_pendulum(), use_cache=False)
     derive(_two_pendulum())  # store
