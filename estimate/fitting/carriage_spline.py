@@ -183,7 +183,16 @@ class CarriageInput:
         """``(A_stage, A_grid, B0)`` as sparse CasADi matrices: :meth:`inputs_matrix` at
         the stage times ``times[k] + fractions * (times[k+1] - times[k])`` and at ``times``,
         and :meth:`design` at ``times``. Kept with this object: every fit of the record
-        (the diagnosis fits many models to it) reuses them."""
+        (the diagnosis fits many models to it) reuses them; :meth:`scipy_matrices` are
+        the first two as SciPy matrices."""
+        return self._matrices(times, fractions)[:3]
+
+    def scipy_matrices(self, times: np.ndarray, fractions: np.ndarray):
+        """``(A_stage, A_grid)`` of :meth:`casadi_matrices` as SciPy CSR matrices (the
+        condensed transcription reads their structure; no conversion back from CasADi)."""
+        return self._matrices(times, fractions)[3:]
+
+    def _matrices(self, times: np.ndarray, fractions: np.ndarray):
         t = np.asarray(times, float)
         fr = np.asarray(fractions, float)
         key = (t.tobytes(), fr.tobytes())
@@ -192,7 +201,8 @@ class CarriageInput:
 
             stage_times = (t[:-1, None] + np.diff(t)[:, None] * fr[None, :]).ravel()
             self._memo.clear()  # one grid at a time: these are large
-            A_stage = sparse_dm(self.inputs_matrix(stage_times))
+            S_stage = self.inputs_matrix(stage_times).tocsr()
+            A_stage = sparse_dm(S_stage)
             if fr[0] == 0.0 and fr[-1] == 1.0:
                 # the grid times are stage times (each interval's first, and the last
                 # interval's end): rows of A_stage, sliced in CasADi (no second conversion)
@@ -201,9 +211,11 @@ class CarriageInput:
                 rows = np.where(k < n - 1, 3 * m * k + i, 3 * m * (n - 2) + 3 * (m - 1) + i)
                 A_grid = A_stage[rows.ravel().tolist(), :]
                 B0 = A_stage[rows[:, 0].tolist(), :]
+                S_grid = S_stage[rows.ravel()]
             else:
-                A_grid, B0 = sparse_dm(self.inputs_matrix(t)), sparse_dm(self.design(t))
-            self._memo[key] = (A_stage, A_grid, B0)
+                S_grid = self.inputs_matrix(t).tocsr()
+                A_grid, B0 = sparse_dm(S_grid), sparse_dm(self.design(t))
+            self._memo[key] = (A_stage, A_grid, B0, S_stage, S_grid)
         return self._memo[key]
 
     def values(self, coefficients: np.ndarray, times: np.ndarray) -> np.ndarray:

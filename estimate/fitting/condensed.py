@@ -150,7 +150,8 @@ def condensed_block(dm: DerivedModel, substeps: int, K: int, p: ca.MX, t: np.nda
     ntheta_all = theta.numel()
     p0, S, cols, theta = _dynamic_parameters(p, theta)
     ntheta = len(cols)
-    win = None if coefficients is None else _Windows.of(coefficients.A, m, nU, K)
+    win = None if coefficients is None else _Windows.of(
+        coefficients.A if coefficients.A_csc is None else coefficients.A_csc, m, nU, K)
     if win is not None and win.width > WINDOW_MAX:
         return None  # inputs not local in their coefficients: a node per sample instead
     width = 0 if win is None else win.width
@@ -225,10 +226,9 @@ class _Windows:
     @classmethod
     def of(cls, A: ca.DM, m: int, nU: int, K: int) -> "_Windows":
         """Windows of the ``m`` intervals of ``K`` steps of ``nU`` stage inputs each,
-        ``vec(U) = A c`` (``A``'s rows past its end: the padded steps, zero)."""
-        from ._sparse import scipy_csc
-
-        C = scipy_csc(A).tocsr().tocoo()  # entries in row order: intervals ascending
+        ``vec(U) = A c`` (``A`` CasADi or SciPy; its rows past its end: the padded steps,
+        zero)."""
+        C = _coo(A, row_order=True)  # entries in row order: intervals ascending
         nc = C.shape[1]
         k = C.row // (nU * K)
         lo = np.zeros(m, dtype=np.int64)
@@ -247,15 +247,13 @@ class _Windows:
         basis = [ca.DM(L[j].reshape(nU, m * width)) for j in range(K)]
         return cls(start, width, lo - start, hi - start, basis, nc)
 
-    def grid_bases(self, A_grid: ca.DM, nu: int, K: int, n: int):
+    def grid_bases(self, A_grid, nu: int, K: int, n: int):
         """The grid inputs' bases over the windows: per step ``j``, the ``nu x width``
         blocks of sample ``k K + j + 1`` of every interval ``k`` side by side, and sample
         0's (interval 0's window). A grid input outside its interval's window is an
         error (the windows are the stage inputs', whose first and last stage times are
         the samples)."""
-        from ._sparse import scipy_csc
-
-        C = scipy_csc(A_grid).tocoo()
+        C = _coo(A_grid)
         m = self.start.size
         s = C.row // nu
         k = np.where(s > 0, (s - 1) // K, 0)
@@ -276,6 +274,17 @@ class _Windows:
                                  indexing="ij")
         keep = (J_ >= self.first[K_]) & (J_ <= self.last[K_])
         return K_[keep], I_[keep], J_[keep]
+
+
+def _coo(A, row_order: bool = False):
+    """A CasADi or SciPy sparse matrix as SciPy COO (entries by rows with ``row_order``)
+    with its structural zeros."""
+    import scipy.sparse as sps
+
+    from ._sparse import scipy_csc
+
+    C = A if sps.issparse(A) else scipy_csc(A)
+    return (C.tocsr() if row_order else C).tocoo()
 
 
 @dataclass(frozen=True)
@@ -337,14 +346,16 @@ def _output_sensitivity(dm: DerivedModel, channels: tuple[str, ...], ntheta: int
 
 def residual_jacobian(dm: DerivedModel, channels: tuple[str, ...], sens: StepSensitivities,
                       Ug: ca.MX | ca.DM, ntheta_all: int, t: np.ndarray, factor: np.ndarray,
-                      compiled: bool, A_grid: ca.DM | None = None
+                      compiled: bool, A_grid=None
                       ) -> tuple[ca.MX, ca.MX, ca.MX | None]:
     """``(d e/d theta, d e/d w, d e/d c)`` of ``e = vec(Y) * factor`` w.r.t. the
     ``ntheta_all`` scaled estimates, the block's nodes and the carriage coefficients
     (``Y`` the measured outputs, samples x channels, channel-major as
     :func:`estimate.fitting.residual_jacobian.force_residual_jacobian`) on a condensed
     block: each sample's output Jacobian composed with its state's sensitivities inside
-    one compiled per-sample function (no sparse products at evaluation)."""
+    one compiled per-sample function (no sparse products at evaluation). ``A_grid``
+    (CasADi or SciPy, ``vec(Ug) = A_grid c``) gives the grid inputs' coefficients when
+    the inputs are estimated."""
     K, m, n, nx, nu, nch = sens.K, sens.m, sens.n, dm.nx, dm.nu, len(channels)
     win = sens.windows
     width = 0 if win is None else win.width

@@ -71,6 +71,9 @@ FREQUENCY_BAND = (0.3, 2.0)
 #: variance): the data then do not prefer one clearly.
 SPREAD_RELATIVE = 0.01
 SPREAD_CHI2 = 25.0
+#: A start within this (relative) of where an earlier search ended at a physical point is
+#: not searched: two steps of the frequency profile's grid, the same minimum.
+SAME_MINIMUM = 0.025
 
 
 @dataclass(frozen=True)
@@ -267,14 +270,17 @@ def identify(records, *, frequency_hz: float, gravity: float | None = None,
         sol.jac = np.hstack([sol.jac, np.zeros((sol.jac.shape[0], n))])
         return sol
 
-    outcomes = []
+    outcomes, searched = [], []
     for f0 in starts:  # the linear mode from every start: cheap, and no start is needed
+        if any(abs(math.exp(sol.x[0]) / (2 * math.pi * f0) - 1) < SAME_MINIMUM
+               and _physical(recs, sol.x) for sol in outcomes):
+            continue  # a physical minimum was found at this start already
         x0 = np.r_[math.log(2 * math.pi * f0), math.log(0.01), np.zeros(n)]
         outcomes.append(search_without_lag(x0))
         x0[2:] = _lag_profile(recs, x0)
         outcomes.append(search(x0))
-    outcomes = [(float(2 * sol.cost), f0, sol) for f0, sol in
-                zip(np.repeat(starts, 2), outcomes)]
+        searched += [f0, f0]
+    outcomes = [(float(2 * sol.cost), f0, sol) for f0, sol in zip(searched, outcomes)]
     # the best physical outcome (positive masses, lags inside the range) first
     outcomes.sort(key=lambda o: (not _physical(recs, o[2].x), o[0]))
     best_cost, _, best = outcomes[0]

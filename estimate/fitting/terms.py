@@ -139,7 +139,8 @@ def case_terms(problem: FitProblem, i: int, theta_s: ca.MX, transcription: Trans
         A_stage, A_grid, B0 = carriage.casadi_matrices(t, fr)
         U = ca.reshape(ca.mtimes(A_stage, c), dm.nu * fr.size, n - 1)
         Ug = ca.reshape(ca.mtimes(A_grid, c), dm.nu, n)
-        coefficients = InputCoefficients(c, A_stage)
+        S_stage, S_grid = carriage.scipy_matrices(t, fr)
+        coefficients = InputCoefficients(c, A_stage, S_stage)
         coef0 = carriage.coefficients
         lag0 = _lag_value(problem, i)
         if warm is not None and warm.carriage is not None and warm.carriage.size == coef0.size:
@@ -227,7 +228,7 @@ def case_terms(problem: FitProblem, i: int, theta_s: ca.MX, transcription: Trans
 
             jt, jx, jc = residual_jacobian(dm, chans, block.state_jacobian, Ug,
                                            theta_s.numel(), t, factor, compile_,
-                                           None if carriage is None else A_grid)
+                                           None if carriage is None else S_grid)
         else:
             jt, jx, jc = force_residual_jacobian(
                 dm, chans, block.X, Ug, p_i, theta_s, t, factor, initial_state == "rest",

@@ -65,10 +65,11 @@ class Block:
 class InputCoefficients:
     """Stage inputs that are a linear function of decision variables: ``vec(U) = A c``
     (``A`` a sparse CasADi matrix, rows in the order of ``vec`` of the ``(nu m, n - 1)``
-    stage inputs)."""
+    stage inputs; ``A_csc`` the same as a SciPy matrix, when the caller has it)."""
 
     c: ca.MX
     A: ca.DM
+    A_csc: object = None
 
 
 class Transcription:
