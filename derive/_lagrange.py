@@ -170,9 +170,7 @@ def assemble(model: Model) -> SymbolicModel:
         plain(kinetic),
         plain(potential),
     )
-    M_plain, f_plain = M, f
-    left = set().union(*(e.atoms(sp.Derivative, AppliedUndef)
-                         for e in (*M_plain, *f_plain, *outputs)))
+    left = set().union(*(e.atoms(sp.Derivative, AppliedUndef) for e in (*M, *f, *outputs)))
     if left:
         named = {u: sp.Symbol(nm) for u, nm in zip(usyms, inputs)}
         left = sorted(str(e.xreplace(named)) for e in left)
@@ -185,6 +183,6 @@ def assemble(model: Model) -> SymbolicModel:
         q=q, qd=qd, qdd=qdd,
         inputs=tuple(inputs), input_units=tuple(units), u=tuple(usyms),
         parameters=names, p=tuple(psym[nm] for nm in names), t=t,
-        mass_matrix=M_plain, forcing=f_plain,
+        mass_matrix=M, forcing=f,
         outputs=outputs, measured=tuple(rig.measured),
     )

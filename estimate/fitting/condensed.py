@@ -224,7 +224,7 @@ class _Windows:
         self.basis, self.n_coefficients = basis, n_coefficients
 
     @classmethod
-    def of(cls, A: ca.DM, m: int, nU: int, K: int) -> "_Windows":
+    def of(cls, A, m: int, nU: int, K: int) -> "_Windows":
         """Windows of the ``m`` intervals of ``K`` steps of ``nU`` stage inputs each,
         ``vec(U) = A c`` (``A`` CasADi or SciPy; its rows past its end: the padded steps,
         zero)."""

@@ -270,19 +270,19 @@ def identify(records, *, frequency_hz: float, gravity: float | None = None,
         sol.jac = np.hstack([sol.jac, np.zeros((sol.jac.shape[0], n))])
         return sol
 
-    outcomes, searched = [], []
+    outcomes = []  # (not physical, cost, start, solution)
     for f0 in starts:  # the linear mode from every start: cheap, and no start is needed
-        if any(abs(math.exp(sol.x[0]) / (2 * math.pi * f0) - 1) < SAME_MINIMUM
-               and _physical(recs, sol.x) for sol in outcomes):
+        if any(not o[0] and abs(math.exp(o[3].x[0]) / (2 * math.pi * f0) - 1) < SAME_MINIMUM
+               for o in outcomes):
             continue  # a physical minimum was found at this start already
         x0 = np.r_[math.log(2 * math.pi * f0), math.log(0.01), np.zeros(n)]
-        outcomes.append(search_without_lag(x0))
+        sols = [search_without_lag(x0)]
         x0[2:] = _lag_profile(recs, x0)
-        outcomes.append(search(x0))
-        searched += [f0, f0]
-    outcomes = [(float(2 * sol.cost), f0, sol) for f0, sol in zip(searched, outcomes)]
+        sols.append(search(x0))
+        outcomes += [(not _physical(recs, sol.x), float(2 * sol.cost), f0, sol) for sol in sols]
     # the best physical outcome (positive masses, lags inside the range) first
-    outcomes.sort(key=lambda o: (not _physical(recs, o[2].x), o[0]))
+    outcomes.sort(key=lambda o: o[:2])
+    outcomes = [o[1:] for o in outcomes]
     best_cost, _, best = outcomes[0]
     r, beta = _projected(recs, best.x)
     F_all = _stacked(recs, best.x)[1]
