@@ -12,14 +12,24 @@ __all__ = ["add_parser"]
 
 
 def add_parser(sub: argparse._SubParsersAction) -> None:
-    from ..diagnosis.families import CAUSES
-
     p = sub.add_parser(
-        "diagnose", help="find what the baseline analog misses, name the cause, extend the model",
-        description="Fit the baseline analog (fixed mass + first-mode pendulum, no hinge spring), "
-                    "collect the residual evidence, try the candidate families "
-                    f"({', '.join(CAUSES)}) and accept those that cut the held-out residual "
-                    "significantly.")
+        "diagnose", help="find what the baseline analog misses, name the cause, extend the model")
+    # the description names the families' causes: importing them imports the fitting code
+    # (SciPy's signal package, about a second), which only `slosh diagnose --help` needs
+    plain = p.format_help
+
+    def format_help() -> str:
+        if p.description is None:
+            from ..diagnosis.families import CAUSES
+
+            p.description = (
+                "Fit the baseline analog (fixed mass + first-mode pendulum, no hinge spring), "
+                "collect the residual evidence, try the candidate families "
+                f"({', '.join(CAUSES)}) and accept those that cut the held-out residual "
+                "significantly.")
+        return plain()
+
+    p.format_help = format_help
     p.add_argument("cases", nargs="+", help="test case files (TOML)")
     p.add_argument("--json", dest="json_out", required=True, help="write the diagnosis as JSON")
     p.add_argument("--report", default=None, help="write the report folder (plots, Markdown)")

@@ -7,11 +7,14 @@ Wire-up: ``estimate.cli`` calls :func:`add_parser` on its subparsers and dispatc
 from __future__ import annotations
 
 import argparse
+from typing import TYPE_CHECKING
 
 from analogs.errors import InputError
-from analogs.tank import Capsule, Cylinder, Liquid, Rectangular, Sphere, predict
 
 from ..outputs import Outputs, json_text
+
+if TYPE_CHECKING:
+    from analogs.tank import Liquid
 
 __all__ = ["add_parser", "run"]
 
@@ -59,6 +62,8 @@ def add_parser(subparsers: argparse._SubParsersAction) -> None:
 
 
 def _tank(args: argparse.Namespace):
+    from analogs.tank import Capsule, Cylinder, Rectangular, Sphere
+
     needed = (("length", "width", "height") if args.shape == "rectangular"
               else ("radius",) if args.shape == "sphere" else ("radius", "length"))
     missing = [f"`--{k}`" for k in needed if getattr(args, k) is None]
@@ -112,6 +117,8 @@ def _label_beside_curve(ax, x: float, y: float, text: str, xs, ys, *, low: bool)
 def _plot(args: argparse.Namespace, tank, liquid: Liquid, path: str, pred) -> None:
     import numpy as np
     from matplotlib.figure import Figure
+
+    from analogs.tank import predict
 
     from .. import _plotting as style
     from .._progress import progress
@@ -204,6 +211,8 @@ def _check_ranges(args: argparse.Namespace) -> None:
 
 def run(args: argparse.Namespace) -> int:
     """Run ``slosh tank``; returns the exit status (2 on bad input)."""
+    from analogs.tank import Liquid, predict
+
     outputs = Outputs(overwrite=args.overwrite)
     outputs.file("--json", args.json).file("--plot", args.plot).check()
     _check_ranges(args)
