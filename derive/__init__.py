@@ -12,7 +12,7 @@ from ._derive import derive
 from .derived import OUTPUT_NAMES, OUTPUT_UNITS, DerivedModel, ParameterError
 from .excitation import Excitation, NoExcitation, Sampled, Sine
 from .export_c import CExport, export_c, has_c_compiler, run_driver, write_input_csv
-from .simulate import RK4, Adaptive, Simulation, rk4_step, simulate
+from .simulate import RK4, Adaptive, Simulation, rk4_step, simulate, simulate_outputs
 
 __all__ = [
     "Adaptive",
@@ -36,6 +36,7 @@ __all__ = [
     "rk4_step",
     "run_driver",
     "simulate",
+    "simulate_outputs",
     "write_input_csv",
 ]
 

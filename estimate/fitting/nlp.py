@@ -75,7 +75,8 @@ def fit(problem: FitProblem, *, transcription: Transcription = MultipleShooting(
         solver_options: Mapping[str, object] | None = None,
         progress: bool | None = None, robust_start: bool = True,
         compile_: bool | None = None, warm_start: FitResult | None = None,
-        balance: bool = True, _free_retry: bool = True) -> FitResult:
+        balance: bool = True, unbounded_retry: bool = True,
+        _free_retry: bool = True) -> FitResult:
     """Estimate the parameters of ``problem``.
 
     Parameters
@@ -120,6 +121,11 @@ def fit(problem: FitProblem, *, transcription: Transcription = MultipleShooting(
         their assumed noise while the force's do not (a planned path given as the
         displacement), refit once with the displacement noise rescaled
         (:mod:`estimate.fitting.balance`), from this fit's solution.
+    unbounded_retry : bool, default True
+        When the fit ends on the liquid mass bound, fit again without it and keep that fit
+        if it converges inside the bound with a smaller residual (a bound met on the way
+        can hold the solver in another valley). ``False`` where the start is known to be
+        in the right valley (a warm start from a fit that had its own retry).
 
     Returns
     -------
@@ -149,7 +155,8 @@ def fit(problem: FitProblem, *, transcription: Transcription = MultipleShooting(
     return refined(problem, result, transcription=transcription, hessian=hessian, cost=cost,
                    initial_state=initial_state, solver_options=solver_options,
                    progress=progress, compile_=compile_, warm_start=warm_start,
-                   balance=balance, free_retry=_free_retry, t_start=t_start)
+                   balance=balance, free_retry=_free_retry,
+                   unbounded_retry=unbounded_retry, t_start=t_start)
 
 
 #: A carriage spline whose knots are more than this many samples apart somewhere (0.25 s at

@@ -29,7 +29,7 @@ def refined(problem: FitProblem, result: FitResult, *, transcription: Transcript
             hessian: Hessian, cost: str, initial_state: str | None,
             solver_options: Mapping[str, object] | None, progress: bool,
             compile_: bool | None, warm_start: FitResult | None, balance: bool,
-            free_retry: bool, t_start: float) -> FitResult:
+            free_retry: bool, t_start: float, unbounded_retry: bool = True) -> FitResult:
     """``result`` (a solve of ``problem``), or the refit that replaces it.
 
     Parameters
@@ -44,13 +44,16 @@ warm_start, balance
     free_retry : bool
         Whether the refits without the liquid bound and inside the tank may run (not
         inside a refit).
+    unbounded_retry : bool
+        Whether the refit without the liquid bound may run (``fit``'s option).
     t_start : float
         ``time.perf_counter()`` when the fit started [s]: a refit's result counts the
         time since.
     """
     from .nlp import IPOPT_DEFAULTS, fit
 
-    if result.converged and result.active_bounds and problem.linear_bounds and free_retry:
+    if result.converged and result.active_bounds and problem.linear_bounds and free_retry \
+            and unbounded_retry:
         # the free fit gets a few times the bounded one's iterations: one that wants more
         # mass than the liquid walks far (a diagnosis baseline lacking two effects: 300
         # iterations, 24 s, to be discarded)

@@ -192,3 +192,26 @@ def test_excitation_size_mismatch_and_bad_grid_are_reported():
         simulate(dm, vals, np.linspace(0, 1, 11), Sine(0.01, 1.0))
     with pytest.raises(ValueError, match="strictly increasing"):
         simulate(dm, vals, np.array([0.0, 0.0, 1.0]))
+
+
+@pytest.mark.parametrize("sampled", [False, True])
+def test_simulate_outputs_is_simulate_per_parameter_set(sampled):
+    """The batched runs are, set by set and output by output, the RK4 runs of ``simulate``
+    (same arithmetic: equal to rounding); a wrong ordering of the mapped columns (runs and
+    samples interleaved) would swap the pendulums' responses."""
+    from derive import simulate_outputs
+
+    model = LateralRig() + Pendulum("q") + HingeDamper("q")
+    t = np.linspace(0.0, 4.0, 401)
+    sine = Sine(0.003, 1.7)
+    exc = Sampled(t, sine.values(t).reshape(3, t.size)) if sampled else sine
+    sets = [{"rig.dry_mass": 0.0, "q.mass": m, "q.length": L, "q.damping": c,
+             "q.hinge_height": 0.05}
+            for m, L, c in ((1.0, 0.08, 1e-3), (0.4, 0.02, 0.0), (2.0, 0.15, 5e-3))]
+    outputs = ("force_x", "torque_y")
+    got = simulate_outputs(model, sets, t, exc, outputs=outputs, substeps=2)
+    assert got.shape == (3, t.size, 2)
+    for k, p in enumerate(sets):
+        ref = simulate(model, p, t, exc, integrator=RK4(2), outputs=outputs).outputs
+        np.testing.assert_allclose(got[k], ref, rtol=1e-12, atol=1e-12 * np.abs(ref).max())
+    assert not np.allclose(got[0], got[1])

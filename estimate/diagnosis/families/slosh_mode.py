@@ -46,10 +46,10 @@ def _probe_columns(ctx: Context, freqs: np.ndarray, zeta: float) -> np.ndarray:
     """The weighted, scaled force of a unit-mass pendulum at each trial frequency, driven
     by each case's carriage motion (the estimated one when there is), placed in the rows of
     the round's linearisation (one column per trial)."""
-    from derive import Sampled, derive, simulate
+    from derive import Sampled, simulate_outputs
 
     current = ctx.current
-    probe = derive(LateralRig() + Pendulum("q") + HingeDamper("q"))
+    probe = LateralRig() + Pendulum("q") + HingeDamper("q")
     Y = np.zeros((len(ctx.linearisation.residuals), freqs.size))
     for i, exp in enumerate(current.problem.experiments):
         t = np.asarray(exp.case.time, float)
@@ -58,15 +58,15 @@ def _probe_columns(ctx: Context, freqs: np.ndarray, zeta: float) -> np.ndarray:
             excitation = Sampled(t, current.carriage[i])
         w = current.weights[i] if current.weights else np.ones(t.size)
         scale = current.problem.channel_scales(i)["force_x"]
-        rows = case_rows(current, i)
         g = exp.case.rig.gravity
-        for k, f in enumerate(freqs):
+        trials = []
+        for f in freqs:
             om = 2 * math.pi * f
             L = g / om**2
-            sim = simulate(probe, {"rig.dry_mass": 0.0, "rig.gravity": g, "q.mass": 1.0,
-                                   "q.length": L, "q.damping": 2 * zeta * L**2 * om}, t,
-                           excitation, outputs=("force_x",))
-            Y[rows, k] = sim.outputs[:, 0] * w / scale
+            trials.append({"rig.dry_mass": 0.0, "rig.gravity": g, "q.mass": 1.0,
+                           "q.length": L, "q.damping": 2 * zeta * L**2 * om})
+        force = simulate_outputs(probe, trials, t, excitation, outputs=("force_x",))[:, :, 0]
+        Y[case_rows(current, i), :] = (force * (w / scale)).T
     return Y
 
 

@@ -37,6 +37,6 @@ def test_the_cli_lists_the_registered_causes():
 
     parser = argparse.ArgumentParser()
     diagnose.add_parser(parser.add_subparsers())
-    text = parser._subparsers._group_actions[0].choices["diagnose"].description
+    text = parser._subparsers._group_actions[0].choices["diagnose"].format_help()
     for cause in CAUSES:
         assert cause in text
