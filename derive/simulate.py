@@ -164,6 +164,26 @@ def _build_simulator(dm: DerivedModel, exc: Excitation, substeps: int, n: int,
     return fn
 
 
+def _arguments(model: DerivedModel | Model, t, excitation: Excitation | None
+               ) -> tuple[DerivedModel, np.ndarray, Excitation]:
+    """The derived model (a ``Model`` derived through the cache), the time grid as a
+    checked 1-D array and the excitation (``None``: none) checked against the model."""
+    if isinstance(model, Model):
+        from ._derive import derive
+
+        model = derive(model)
+    t = np.asarray(t, float).ravel()
+    if t.size < 2 or np.any(np.diff(t) <= 0):
+        raise InputError("t must be a strictly increasing array of at least 2 times (s)")
+    exc = excitation if excitation is not None else NoExcitation(size=model.nu)
+    if exc.size != model.nu:
+        raise InputError(
+            f"the excitation supplies {exc.size} input values but the model takes {model.nu} "
+            f"({', '.join(model.inputs) or 'none'})"
+        )
+    return model, t, exc
+
+
 def _initial_state(dm: DerivedModel, x0) -> np.ndarray:
     if x0 is None:
         return np.zeros(dm.nx)
@@ -221,20 +241,7 @@ def simulate(
     >>> sim.output("force_x").shape
     (101,)
     """
-    if isinstance(model, Model):
-        from ._derive import derive
-
-        model = derive(model)
-    dm = model
-    t = np.asarray(t, float).ravel()
-    if t.size < 2 or np.any(np.diff(t) <= 0):
-        raise InputError("t must be a strictly increasing array of at least 2 times (s)")
-    exc = excitation if excitation is not None else NoExcitation(size=dm.nu)
-    if exc.size != dm.nu:
-        raise InputError(
-            f"the excitation supplies {exc.size} input values but the model takes {dm.nu} "
-            f"({', '.join(dm.inputs) or 'none'})"
-        )
+    dm, t, exc = _arguments(model, t, excitation)
     p = dm.parameter_vector(params, outputs=outputs)
     x_init = _initial_state(dm, x0)
     names = OUTPUT_NAMES if outputs is None else tuple(outputs)
@@ -278,21 +285,8 @@ def simulate_outputs(model: DerivedModel | Model, params: Sequence[Mapping[str, 
     call: a scan of 70 trial pendulums on 3001 samples takes 0.4 s, where 70 calls of
     :func:`simulate` took 1.8 s (most of it sampling the same excitation again).
     """
-    if isinstance(model, Model):
-        from ._derive import derive
-
-        model = derive(model)
-    dm = model
-    t = np.asarray(t, float).ravel()
-    if t.size < 2 or np.any(np.diff(t) <= 0):
-        raise InputError("t must be a strictly increasing array of at least 2 times (s)")
+    dm, t, exc = _arguments(model, t, excitation)
     RK4(substeps)  # checks substeps
-    exc = excitation if excitation is not None else NoExcitation(size=dm.nu)
-    if exc.size != dm.nu:
-        raise InputError(
-            f"the excitation supplies {exc.size} input values but the model takes {dm.nu} "
-            f"({', '.join(dm.inputs) or 'none'})"
-        )
     if not params:
         return np.zeros((0, t.size, len(outputs)))
     P = np.column_stack([dm.parameter_vector(p, outputs=outputs) for p in params])
