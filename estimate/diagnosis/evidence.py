@@ -367,7 +367,7 @@ def segment_damping(result: FitResult, *, case: int = 0, n_segments: int = 4,
                                                        "p1.length": values["p1.length"]},
                                    bounds={"p1.length": (0.5 * values["p1.length"],
                                                          2.0 * values["p1.length"])},
-                                   input="filtered")
+                                   input="filtered", first_stage=False)  # starts given
             r = fit(sub, initial_state="free", progress=False, robust_start=False,
                     solver_options={"ipopt.max_iter": SEGMENT_ITERATIONS})
         except (ValueError, RuntimeError):
