@@ -66,7 +66,8 @@ SECONDS_PER_SAMPLE = 0.015
 #: take 5-10 times longer per residual (a rotary oscillator's diagnosis of 20 s took
 #: minutes): 480 s for 20 s at 100 Hz.
 SECONDS_PER_SPINNING_SAMPLE = 0.04
-#: The first mode's mass is kept above this share of its predicted mass: a pendulum
+#: A pendulum's mass is kept above this share of its initial one in a fit from a
+#: prediction or a scan (:func:`_stable`): a pendulum
 #: whose mass goes to zero leaves its damper free, and a heavy damper on a tiny bob is a
 #: stiff system RK4 cannot step (a baseline without the spring of a diaphragm record
 #: went there, its RK4 states overflowed and MUMPS reallocated memory for minutes).
@@ -74,7 +75,7 @@ MIN_MASS_SHARE = 0.1
 #: ... and its damper below the value where one RK4 step of the sample interval ``h`` on
 #: the lightest, shortest pendulum the bounds allow has ``h c / (m L^2)`` = this (RK4 is
 #: stable below ~2.8 on a real eigenvalue). On the 8-inch sphere at 100 Hz that is a
-#: damping ratio of about 0.5 at the predicted mass.
+#: damping ratio of about 0.5 at the predicted mass of the first mode.
 RK4_MARGIN = 2.0
 #: IPOPT statuses that mean a budget ended the fit.
 _ENDED_BY = {"Maximum_Iterations_Exceeded": "iterations", "Maximum_CpuTime_Exceeded": "time"}
@@ -98,27 +99,46 @@ class FitRecord:
                 f"({self.budget} budget){ended}")
 
 
-def _stable(prob: FitProblem, hold: dict[str, float]) -> FitProblem:
-    """``prob`` with the first mode's mass and damper bounded (:data:`MIN_MASS_SHARE`,
-    :data:`RK4_MARGIN`) on the lateral rig, where its initial values are the prediction."""
+def _stable(prob: FitProblem, hold: dict[str, float], pendulums: set[str] | None = None
+            ) -> FitProblem:
+    """``prob`` with the mass and damper of each pendulum of ``pendulums`` (default: every
+    one) bounded (:data:`MIN_MASS_SHARE` of its initial mass, :data:`RK4_MARGIN`) on the
+    lateral rig: a cold start's initial values are the prediction, a new mode's its scan's.
+    Without them a second mode's candidate, started from a scan 40 % heavy, took its bob
+    towards the mass's lower bound under a free damper and its fit ran 23 minutes of
+    IPOPT iterations over a 15 s budget (the budget is checked between iterations)."""
     from dataclasses import replace
 
     from analogs import Pendulum
 
-    if not any(isinstance(c, Pendulum) and c.name == "p1" for c in prob.model.components):
-        return prob
     est = {e.name: e for e in prob.estimated}
-    m, c = est.get("p1.mass"), est.get("p1.damping")
-    L = est["p1.length"].lower if "p1.length" in est else hold.get("p1.length")
-    if m is None or L is None or c is None:
-        return prob
     h = min(float(np.median(np.diff(e.case.time))) for e in prob.experiments)
-    m_lo = max(m.lower, MIN_MASS_SHARE * m.initial)
-    c_hi = min(c.upper, RK4_MARGIN * m_lo * L**2 / h)
-    if c_hi <= c.lower:
+    new = {}
+    for comp in prob.model.components:
+        if not isinstance(comp, Pendulum) or (pendulums is not None
+                                              and comp.name not in pendulums):
+            continue
+        m, c = est.get(f"{comp.name}.mass"), est.get(f"{comp.name}.damping")
+        length = est.get(f"{comp.name}.length")
+        L = length.lower if length is not None else hold.get(f"{comp.name}.length")
+        if m is None or L is None or c is None:
+            continue
+        m_lo = max(m.lower, MIN_MASS_SHARE * m.initial)
+        c_hi = min(c.upper, RK4_MARGIN * m_lo * L**2 / h)
+        if c_hi > c.lower:
+            new |= {m.name: replace(m, lower=m_lo),
+                    c.name: replace(c, upper=c_hi, initial=min(c.initial, c_hi))}
+    if not new:
         return prob
-    new = {m.name: replace(m, lower=m_lo), c.name: replace(c, upper=c_hi)}
     return replace(prob, estimated=tuple(new.get(e.name, e) for e in prob.estimated))
+
+
+def _new_pendulums(model: Model, warm: FitResult) -> set[str]:
+    """The pendulums of ``model`` whose mass ``warm`` did not estimate (a new mode)."""
+    from analogs import Pendulum
+
+    return {c.name for c in model.components if isinstance(c, Pendulum)
+            and f"{c.name}.mass" not in warm.names}
 
 
 class Fitter:
@@ -162,10 +182,12 @@ class Fitter:
         self.held = dict(self._holds.get(id(result), self.held))
 
     def problem(self, model: Model, measurement: Sequence[MeasurementModel], initial,
-                bounds=None, *, weights="default", hold=None, stable: bool = False) -> FitProblem:
+                bounds=None, *, weights="default", hold=None,
+                stable: bool | set[str] = False) -> FitProblem:
         """The fit problem of the diagnosed cases (held-out weights unless ``weights`` is
-        given; what an accepted candidate holds held); ``stable``: with the first mode's
-        stability bounds (:data:`MIN_MASS_SHARE`, :data:`RK4_MARGIN`). No stream lag: the
+        given; what an accepted candidate holds held); ``stable``: with the pendulums'
+        stability bounds (:data:`MIN_MASS_SHARE`, :data:`RK4_MARGIN`; ``True``: every
+        pendulum's, a set: those pendulums'). No stream lag: the
         sensor-delay family names one (:mod:`.families.delay`)."""
         w = self.weights if weights == "default" else weights
         cutoff = self.cutoff if self.input == "filtered" else "auto"
@@ -174,9 +196,9 @@ class Fitter:
         prob = FitProblem.build(self.cases, model, measurement=tuple(measurement), weights=w,
                                 bounds=bounds, hold=hold, force_cutoff_hz=cutoff,
                                 input=self.input, lag="none")
-        prob = _stable(prob, hold) if stable else prob
         known = {e.name for e in prob.estimated}
-        return prob.with_initial({k: v for k, v in initial.items() if k in known})
+        prob = prob.with_initial({k: v for k, v in initial.items() if k in known})
+        return _stable(prob, hold, None if stable is True else stable) if stable else prob
 
     def __call__(self, model: Model, measurement: Sequence[MeasurementModel], initial,
                  bounds=None, *, weights="default", warm: FitResult | None = None,
@@ -187,7 +209,7 @@ class Fitter:
         # fit, and the bounds cost it (a whole-record fit warm-started from a second mode's
         # ran 40 iterations off it with the damper's bound, 5 without)
         prob = self.problem(model, measurement, initial, bounds, weights=weights, hold=hold,
-                            stable=warm is None)
+                            stable=True if warm is None else _new_pendulums(model, warm))
         if not all(len(e.channels) == 1 for e in prob.experiments):
             budget = BUDGETS["spinning"]
         elif warm is None:
