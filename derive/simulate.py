@@ -284,6 +284,21 @@ def simulate_outputs(model: DerivedModel | Model, params: Sequence[Mapping[str, 
     The excitation is sampled at the stage times once and the runs are one mapped CasADi
     call: a scan of 70 trial pendulums on 3001 samples takes 0.4 s, where 70 calls of
     :func:`simulate` took 1.8 s (most of it sampling the same excitation again).
+
+    Parameters
+    ----------
+    model : DerivedModel or analogs.Model
+        A derived model (a ``Model`` is derived first, through the cache).
+    params : sequence of mappings
+        Parameter values by dotted name (over the declared defaults), one mapping per run.
+    t : array
+        Increasing output times (s).
+    excitation : Excitation, optional
+        Rig input signals, the same for every run; ``None`` means a tank at rest.
+    outputs : tuple of str
+        Output channels (:data:`derive.OUTPUT_NAMES`); their parameters must have values.
+    substeps : int, default 1
+        RK4 steps per output interval.
     """
     dm, t, exc = _arguments(model, t, excitation)
     RK4(substeps)  # checks substeps
