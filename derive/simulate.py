@@ -184,6 +184,17 @@ def _arguments(model: DerivedModel | Model, t, excitation: Excitation | None
     return model, t, exc
 
 
+def _sampled_inputs(dm: DerivedModel, exc: Excitation, t: np.ndarray, substeps: int
+                    ) -> tuple[np.ndarray, np.ndarray]:
+    """The simulator's ``U`` (inputs at the RK4 stage times) and ``Ug`` (at the grid);
+    empty for an analytic excitation, which the simulator evaluates inside."""
+    n = t.size - 1
+    if exc.analytic:
+        return np.zeros((0, n)), np.zeros((0, n + 1))
+    U = interval_inputs(exc, t, np.arange(2 * substeps + 1) / (2 * substeps), dm.nu)
+    return U, exc.values(t).reshape(dm.nu, t.size)
+
+
 def _initial_state(dm: DerivedModel, x0) -> np.ndarray:
     if x0 is None:
         return np.zeros(dm.nx)
@@ -252,12 +263,7 @@ def simulate(
     if isinstance(integrator, RK4):
         s = integrator.substeps
         h = np.diff(t)
-        if exc.analytic:
-            U = np.zeros((0, n))
-            Ug = np.zeros((0, n + 1))
-        else:
-            U = interval_inputs(exc, t, np.arange(2 * s + 1) / (2 * s), dm.nu)
-            Ug = exc.values(t).reshape(dm.nu, t.size)
+        U, Ug = _sampled_inputs(dm, exc, t, s)
         fn = _simulator(dm, exc, s, n, idx, integrator.compiled)
         X, Y = fn(x_init, U, p, t.reshape(1, -1), h.reshape(1, -1), Ug)
         X, Y = np.asarray(X), np.asarray(Y)
@@ -306,13 +312,8 @@ def simulate_outputs(model: DerivedModel | Model, params: Sequence[Mapping[str, 
         return np.zeros((0, t.size, len(outputs)))
     P = np.column_stack([dm.parameter_vector(p, outputs=outputs) for p in params])
     idx = tuple(dm.output_index(nm) for nm in outputs)
-    n = t.size - 1
-    if exc.analytic:
-        U, Ug = np.zeros((0, n)), np.zeros((0, n + 1))
-    else:
-        U = interval_inputs(exc, t, np.arange(2 * substeps + 1) / (2 * substeps), dm.nu)
-        Ug = exc.values(t).reshape(dm.nu, t.size)
-    fn = _simulator(dm, exc, substeps, n, idx, False).map(P.shape[1])
+    U, Ug = _sampled_inputs(dm, exc, t, substeps)
+    fn = _simulator(dm, exc, substeps, t.size - 1, idx, False).map(P.shape[1])
     _, Y = fn(np.zeros(dm.nx), U, P, t.reshape(1, -1), np.diff(t).reshape(1, -1), Ug)
     # the mapped outputs are side by side: (outputs, runs * samples)
     Y = np.asarray(Y).reshape(len(outputs), P.shape[1], t.size)

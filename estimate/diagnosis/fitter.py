@@ -5,7 +5,7 @@ and a log of what each fit was for, how long it took and which budget, if any, e
 from __future__ import annotations
 
 import time
-from collections.abc import Sequence
+from collections.abc import Collection, Sequence
 from dataclasses import dataclass
 
 import numpy as np
@@ -99,24 +99,24 @@ class FitRecord:
                 f"({self.budget} budget){ended}")
 
 
-def _stable(prob: FitProblem, hold: dict[str, float], pendulums: set[str] | None = None
+def _stable(prob: FitProblem, hold: dict[str, float], pendulums: Collection[str]
             ) -> FitProblem:
-    """``prob`` with the mass and damper of each pendulum of ``pendulums`` (default: every
-    one) bounded (:data:`MIN_MASS_SHARE` of its initial mass, :data:`RK4_MARGIN`) on the
+    """``prob`` with the mass and damper of each pendulum named in ``pendulums`` bounded
+    (:data:`MIN_MASS_SHARE` of its initial mass, :data:`RK4_MARGIN`) on the
     lateral rig: a cold start's initial values are the prediction, a new mode's its scan's.
-    Without them a second mode's candidate, started from a scan 40 % heavy, took its bob
-    towards the mass's lower bound under a free damper and its fit ran 23 minutes of
-    IPOPT iterations over a 15 s budget (the budget is checked between iterations)."""
+    Without them a second mode's candidate started from a poor scan (4.8 Hz, 0.089 kg for
+    a 3.8 Hz, 0.06 kg mode) took its bob towards the mass's lower bound under a free
+    damper and its fit ran 23 minutes of IPOPT iterations over a 15 s budget (the budget
+    is checked between iterations)."""
     from dataclasses import replace
 
     from analogs import Pendulum
 
     est = {e.name: e for e in prob.estimated}
-    h = min(float(np.median(np.diff(e.case.time))) for e in prob.experiments)
+    h = min(e.case.sample_interval for e in prob.experiments)
     new = {}
     for comp in prob.model.components:
-        if not isinstance(comp, Pendulum) or (pendulums is not None
-                                              and comp.name not in pendulums):
+        if not isinstance(comp, Pendulum) or comp.name not in pendulums:
             continue
         m, c = est.get(f"{comp.name}.mass"), est.get(f"{comp.name}.damping")
         length = est.get(f"{comp.name}.length")
@@ -133,12 +133,14 @@ def _stable(prob: FitProblem, hold: dict[str, float], pendulums: set[str] | None
     return replace(prob, estimated=tuple(new.get(e.name, e) for e in prob.estimated))
 
 
-def _new_pendulums(model: Model, warm: FitResult) -> set[str]:
-    """The pendulums of ``model`` whose mass ``warm`` did not estimate (a new mode)."""
+def _new_pendulums(model: Model, warm: FitResult | None) -> set[str]:
+    """The pendulums of ``model`` whose mass ``warm`` did not estimate (a new mode; every
+    pendulum of a cold start, ``warm`` None)."""
     from analogs import Pendulum
 
+    fitted = set(warm.names) if warm is not None else set()
     return {c.name for c in model.components if isinstance(c, Pendulum)
-            and f"{c.name}.mass" not in warm.names}
+            and f"{c.name}.mass" not in fitted}
 
 
 class Fitter:
@@ -183,11 +185,10 @@ class Fitter:
 
     def problem(self, model: Model, measurement: Sequence[MeasurementModel], initial,
                 bounds=None, *, weights="default", hold=None,
-                stable: bool | set[str] = False) -> FitProblem:
+                stable: Collection[str] = ()) -> FitProblem:
         """The fit problem of the diagnosed cases (held-out weights unless ``weights`` is
-        given; what an accepted candidate holds held); ``stable``: with the pendulums'
-        stability bounds (:data:`MIN_MASS_SHARE`, :data:`RK4_MARGIN`; ``True``: every
-        pendulum's, a set: those pendulums'). No stream lag: the
+        given; what an accepted candidate holds held); ``stable``: the pendulums that get
+        the stability bounds (:data:`MIN_MASS_SHARE`, :data:`RK4_MARGIN`). No stream lag: the
         sensor-delay family names one (:mod:`.families.delay`)."""
         w = self.weights if weights == "default" else weights
         cutoff = self.cutoff if self.input == "filtered" else "auto"
@@ -198,7 +199,7 @@ class Fitter:
                                 input=self.input, lag="none")
         known = {e.name for e in prob.estimated}
         prob = prob.with_initial({k: v for k, v in initial.items() if k in known})
-        return _stable(prob, hold, None if stable is True else stable) if stable else prob
+        return _stable(prob, hold, stable) if stable else prob
 
     def __call__(self, model: Model, measurement: Sequence[MeasurementModel], initial,
                  bounds=None, *, weights="default", warm: FitResult | None = None,
@@ -209,7 +210,7 @@ class Fitter:
         # fit, and the bounds cost it (a whole-record fit warm-started from a second mode's
         # ran 40 iterations off it with the damper's bound, 5 without)
         prob = self.problem(model, measurement, initial, bounds, weights=weights, hold=hold,
-                            stable=True if warm is None else _new_pendulums(model, warm))
+                            stable=_new_pendulums(model, warm))
         if not all(len(e.channels) == 1 for e in prob.experiments):
             budget = BUDGETS["spinning"]
         elif warm is None:
