@@ -149,19 +149,28 @@ class CarriageInput:
     _memo: dict = field(default_factory=dict, compare=False, repr=False)
     _shift_memo: dict = field(default_factory=dict, compare=False, repr=False)
 
-    def derivative_designs(self, times: np.ndarray, order: int) -> tuple:
-        """``design(times, d) / d!`` for ``d = 0..order`` as sparse CasADi matrices: the
-        Taylor series of the spline shifted in time (a stream lag). Kept with this object."""
+    def taylor_designs(self, times: np.ndarray, order: int) -> tuple:
+        """``design(times, d) / d!`` for ``d = 0..order`` as SciPy CSR matrices: the Taylor
+        series of the spline shifted in time (a stream lag). Kept with this object."""
         import math
 
+        t = np.asarray(times, float)
+        key = ("scipy", t.tobytes(), order)
+        if key not in self._shift_memo:
+            self._shift_memo.clear()
+            self._shift_memo[key] = tuple(self.design(t, d) / math.factorial(d)
+                                          for d in range(order + 1))
+        return self._shift_memo[key]
+
+    def derivative_designs(self, times: np.ndarray, order: int) -> tuple:
+        """:meth:`taylor_designs` as sparse CasADi matrices. Kept with this object."""
         from ._sparse import sparse_dm
 
         t = np.asarray(times, float)
-        key = (t.tobytes(), order)
+        key = ("casadi", t.tobytes(), order)
         if key not in self._shift_memo:
-            self._shift_memo.clear()
-            self._shift_memo[key] = tuple(sparse_dm(self.design(t, d) / math.factorial(d))
-                                          for d in range(order + 1))
+            designs = self.taylor_designs(t, order)
+            self._shift_memo[key] = tuple(sparse_dm(D) for D in designs)
         return self._shift_memo[key]
 
     @property

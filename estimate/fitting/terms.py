@@ -286,12 +286,11 @@ def _stream_lag(problem: FitProblem, i: int, theta_s: ca.MX):
 def lag_start(carriage, times: np.ndarray, lag: float, order: int) -> np.ndarray:
     """Start coefficients of the carriage spline when the displacement stream leads the
     force by ``lag`` seconds: the least-squares spline ``s`` with ``s(t + lag) = x_rec(t)``."""
-    import math
-
     import scipy.sparse as sps
     import scipy.sparse.linalg as spla
 
-    B = sum(lag**d / math.factorial(d) * carriage.design(times, d) for d in range(order + 1))
+    designs = carriage.taylor_designs(times, order)
+    B = sum((lag**d * designs[d] for d in range(1, order + 1)), designs[0])
     A = (B.T @ B).tocsc()
     A = A + 1e-10 * A.diagonal().mean() * sps.identity(A.shape[0], format="csc")
     return np.asarray(spla.spsolve(A, B.T @ carriage.displacement)).ravel()
