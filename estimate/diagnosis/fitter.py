@@ -67,10 +67,10 @@ SECONDS_PER_SAMPLE = 0.015
 #: minutes): 480 s for 20 s at 100 Hz.
 SECONDS_PER_SPINNING_SAMPLE = 0.04
 #: A pendulum's mass is kept above this share of its initial one in a fit from a
-#: prediction or a scan (:func:`_stable`): a pendulum
-#: whose mass goes to zero leaves its damper free, and a heavy damper on a tiny bob is a
-#: stiff system RK4 cannot step (a baseline without the spring of a diaphragm record
-#: went there, its RK4 states overflowed and MUMPS reallocated memory for minutes).
+#: prediction or a scan (:func:`_stable`): a pendulum whose mass goes to zero leaves its
+#: damper free, and a heavy damper on a tiny bob is a stiff system RK4 cannot step (a
+#: baseline without the spring of a diaphragm record went there, its RK4 states
+#: overflowed and MUMPS reallocated memory for minutes).
 MIN_MASS_SHARE = 0.1
 #: ... and its damper below the value where one RK4 step of the sample interval ``h`` on
 #: the lightest, shortest pendulum the bounds allow has ``h c / (m L^2)`` = this (RK4 is
