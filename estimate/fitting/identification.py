@@ -172,8 +172,11 @@ class FirstStage:
 
     def describe(self) -> str:
         """One sentence for the fit's notes."""
-        lag = ", ".join(f"{1e3 * t:.1f} +/- {1e3 * s:.1f} ms" for t, s in
-                        zip(self.lags, self.lag_stderr))
+        # the lag's standard error is what the force noise alone allows (it decides whether
+        # the fit estimates the lag); the linear mode's misfit of the record is not in it,
+        # so it is not given as the lag's interval
+        lag = ", ".join(f"{1e3 * t:.1f} ms (standard error {1e3 * s:.2g} ms at the force "
+                        f"noise alone)" for t, s in zip(self.lags, self.lag_stderr))
         text = (f"first stage (linear identification, {len(self.starts)} starts): mode "
                 f"{self.frequency_hz:.4g} Hz, damping ratio {self.damping_ratio:.3g}, slosh mass "
                 f"{self.slosh_mass:.4g} kg, rigid mass {self.rigid_mass:.4g} kg, force stream lag "
