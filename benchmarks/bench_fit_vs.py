@@ -8,7 +8,9 @@ each checkout runs in its own long-lived process that fits bench_fit's records
 are asked in turn, alternating which goes first, so every pair of fits meets the same
 load. Printed per record: the median and smallest CPU time of each checkout and the
 median of the pairwise ratios (this / other), the figure to compare with a target such
-as "within 10 %".
+as "within 10 %", with its distribution-free 95 % interval (order statistics of the pair
+ratios: the median lies between them with 95 % probability whatever the load's
+distribution, pairs taken as independent).
 """
 
 import argparse
@@ -62,10 +64,26 @@ def compare(label: str, other: Path, pairs: int) -> str:
             p.stdin.close()
             p.wait()
     ours, theirs = times
-    ratio = statistics.median(a / b for a, b in zip(ours, theirs))
+    ratios = sorted(a / b for a, b in zip(ours, theirs))
+    lo, hi = median_interval(ratios)
     return (f"  {label:22s} this: median {statistics.median(ours):.3f} s, min {min(ours):.3f} s"
             f" | other: median {statistics.median(theirs):.3f} s, min {min(theirs):.3f} s"
-            f" | this/other, median of {pairs} pairs: {ratio:.3f}")
+            f" | this/other, median of {pairs} pairs: {statistics.median(ratios):.3f}"
+            f" (95 % interval {lo:.3f}-{hi:.3f})")
+
+
+def median_interval(values, level: float = 0.95) -> tuple[float, float]:
+    """A distribution-free interval of the median of ``values`` (sorted): the order
+    statistics ``k`` and ``n - 1 - k`` with ``k`` the largest for which a Binomial(n, 1/2)
+    count falls below ``k`` or above ``n - 1 - k`` with probability at most ``1 - level``
+    (the whole range when ``n`` is too small for that)."""
+    from scipy.stats import binom
+
+    n = len(values)
+    k = int(binom.ppf((1 - level) / 2, n, 0.5))
+    k = k - 1 if binom.cdf(k, n, 0.5) > (1 - level) / 2 else k
+    k = max(k, 0)
+    return values[k], values[n - 1 - k]
 
 
 def main() -> None:
