@@ -56,6 +56,14 @@ IPOPT_DEFAULTS = {
     # 1.4e-6 from iteration 10, "Error_In_Step_Computation" at 13). Four iterations within
     # 1e-5 end the fit as "Solved_To_Acceptable_Level" instead.
     "ipopt.acceptable_tol": 1e-5, "ipopt.acceptable_iter": 4,
+    # bound multipliers start at 1e-5, not IPOPT's 1: most bounds of a fit are inactive
+    # (masses > 0, a hinge spring >= 0 the record may not need), and a multiplier z of a
+    # bound at distance s adds z/s to that parameter's curvature. Started at 1, it halves
+    # every step towards a bound: a 60 s record's hinge spring, whose optimum sits just
+    # below 0, took 14 iterations (9 with the bound lifted). A multiplier the optimum
+    # needs grows by Newton steps. Iterations 9/11/14 -> 5/6/6 on 6/20/60 s records and
+    # 11/9/14 -> 6/5/9 on bench_fit's, the same estimates to 1e-6 of their values.
+    "ipopt.bound_mult_init_val": 1e-5,
 }
 @dataclass(frozen=True)
 class Hessian:
