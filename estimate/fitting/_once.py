@@ -15,15 +15,23 @@ __all__ = ["OncePerPoint"]
 
 class OncePerPoint(ca.Callback):
     """``fn`` (one input, a column) as a CasADi callback that keeps its outputs for the
-    last input it saw. The Python object must outlive every function that calls it."""
+    last input it saw. It evaluates ``fn`` through a :meth:`casadi.Function.buffer`, whose
+    work vector is allocated once: a fresh call allocates it every time (72 MB for a 30,001-
+    sample fit, about 60 ms of page faults per iterate). The Python object must outlive
+    every function that calls it."""
 
     def __init__(self, name: str, fn: ca.Function) -> None:
         ca.Callback.__init__(self)
         if fn.n_in() != 1 or fn.size2_in(0) != 1:
             raise ValueError("OncePerPoint wraps a function of one column input")
         self._fn = fn
-        self._point: np.ndarray | None = None
-        self._outputs: list | None = None
+        self._point = np.zeros(fn.nnz_in(0))
+        self._outputs = [np.zeros(fn.nnz_out(i)) for i in range(fn.n_out())]
+        self._fresh = False
+        self._buffer, self._evaluate = fn.buffer()
+        self._buffer.set_arg(0, memoryview(self._point))
+        for i, out in enumerate(self._outputs):
+            self._buffer.set_res(i, memoryview(out))
         self.construct(name, {})
 
     def get_n_in(self) -> int:
@@ -41,9 +49,16 @@ class OncePerPoint(ca.Callback):
     def has_jacobian(self) -> bool:
         return False
 
-    def eval(self, args):
-        w = np.asarray(args[0].nonzeros(), float)
-        if self._point is None or not np.array_equal(w, self._point):
-            self._outputs = self._fn.call([args[0]])
-            self._point = w
-        return list(self._outputs)
+    def has_eval_buffer(self) -> bool:
+        return True
+
+    def eval_buffer(self, arg, res) -> int:
+        w = np.zeros(self._point.size) if arg[0] is None else np.frombuffer(arg[0], float)
+        if not (self._fresh and np.array_equal(w, self._point)):
+            self._point[:] = w
+            self._evaluate()
+            self._fresh = True
+        for out, r in zip(self._outputs, res):
+            if r is not None:
+                np.frombuffer(r, float)[:] = out
+        return 0

@@ -1,0 +1,30 @@
+"""OncePerPoint serves a function's outputs, dense and sparse, from its buffer: the same
+numbers as calling the function, at every point, in any order of points."""
+
+import casadi as ca
+import numpy as np
+
+from estimate.fitting._once import OncePerPoint
+
+
+def _wrapped():
+    w = ca.MX.sym("w", 3)
+    # a sparse output whose structure is not the dense one's, and a dense one
+    J = ca.sparsify(ca.DM([[1, 0, 2], [0, 0, 3]])) * ca.sin(w[0]) + ca.DM([[0, 0, 1], [0, 0, 0]]) * w[2]
+    return ca.Function("f", [w], [w[1] ** 2 * ca.exp(w), J])
+
+
+def test_outputs_equal_the_functions_at_every_point_and_after_a_revisit():
+    f = _wrapped()
+    once = OncePerPoint("once", f)
+    w = ca.MX.sym("w", 3)
+    # two consumers of the same iterate, as IPOPT's gradient and Hessian functions are
+    g = ca.Function("g", [w], [once(w)[0] * 2, ca.mtimes(once(w)[1].T, once(w)[1])])
+    rng = np.random.default_rng(1)
+    points = [rng.normal(size=3) for _ in range(3)]
+    for p in points + points[::-1]:  # revisiting a point after another recomputes it
+        a, b = g(p)
+        fa, fb = f(p)
+        np.testing.assert_allclose(np.asarray(a), 2 * np.asarray(fa), rtol=1e-15)
+        np.testing.assert_allclose(np.asarray(b), np.asarray(ca.mtimes(fb.T, fb)), rtol=1e-15)
+        assert once(p)[1].sparsity() == f.sparsity_out(1)
