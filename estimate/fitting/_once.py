@@ -26,13 +26,17 @@ class OncePerPoint(ca.Callback):
             raise ValueError("OncePerPoint wraps a function of one column input")
         self._fn = fn
         self._point = np.zeros(fn.nnz_in(0))
-        self._outputs = [np.zeros(fn.nnz_out(i)) for i in range(fn.n_out())]
+        self._outputs: list[np.ndarray] = []
         self._fresh = False
-        self._buffer, self._evaluate = fn.buffer()
-        self._buffer.set_arg(0, memoryview(self._point))
-        for i, out in enumerate(self._outputs):
-            self._buffer.set_res(i, memoryview(out))
+        self._buffer = self._evaluate = None
         self.construct(name, {})
+
+    def release(self) -> None:
+        """Free the buffer and the kept outputs (the next evaluation makes them again):
+        after the solve, so the covariance does not find them still allocated."""
+        self._buffer = self._evaluate = None
+        self._outputs = []
+        self._fresh = False
 
     def get_n_in(self) -> int:
         return 1
@@ -55,6 +59,13 @@ class OncePerPoint(ca.Callback):
     def eval_buffer(self, arg, res) -> int:
         w = np.zeros(self._point.size) if arg[0] is None else np.frombuffer(arg[0], float)
         if not (self._fresh and np.array_equal(w, self._point)):
+            if self._buffer is None:
+                fn = self._fn
+                self._outputs = [np.zeros(fn.nnz_out(i)) for i in range(fn.n_out())]
+                self._buffer, self._evaluate = fn.buffer()
+                self._buffer.set_arg(0, memoryview(self._point))
+                for i, out in enumerate(self._outputs):
+                    self._buffer.set_res(i, memoryview(out))
             self._point[:] = w
             self._evaluate()
             self._fresh = True

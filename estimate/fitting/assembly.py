@@ -234,6 +234,11 @@ class AssembledNlp:
     def _keep(self) -> list:
         return []
 
+    def release_buffers(self) -> None:
+        """Free the memory the solver's once-per-point Jacobians keep between calls."""
+        for once in self._keep:
+            once.release()
+
     def constraint_jacobian(self, blocks_ok: bool) -> ca.Function | None:
         """``w -> (g, dg/dw)`` assembled from per-interval blocks, or ``None`` (then CasADi
         differentiates ``g``)."""

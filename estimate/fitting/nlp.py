@@ -223,8 +223,9 @@ def _solve(problem: FitProblem, transcription: Transcription, hessian: Hessian, 
     w_opt = np.asarray(sol["x"]).ravel()
     # IPOPT may leave a bounded variable a hair outside its bound (its bound_relax_factor)
     theta = np.clip(w_opt[: len(est)] * scales, [e.lower for e in est], [e.upper for e in est])
-    out = nlp.outputs_at(w_opt, cost)
     _, Jg = solver.get_function("nlp_jac_g")(w_opt, [])
+    nlp.release_buffers()  # the iterates' Jacobians are no longer asked for
+    out = nlp.outputs_at(w_opt, cost)
     Je, Jg = scipy_csc(out.jacobian), scipy_csc(Jg)
     Jg = Jg[: Jg.shape[0] - nlp.n_linear]  # the dynamics; the linear bounds are the masses'
     J = reduced_jacobian(Je, Jg, len(est), scales, list(nlp.free_states))

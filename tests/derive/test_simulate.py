@@ -215,3 +215,27 @@ def test_simulate_outputs_is_simulate_per_parameter_set(sampled):
         ref = simulate(model, p, t, exc, integrator=RK4(2), outputs=outputs).outputs
         np.testing.assert_allclose(got[k], ref, rtol=1e-12, atol=1e-12 * np.abs(ref).max())
     assert not np.allclose(got[0], got[1])
+
+
+def test_a_run_longer_than_a_chunk_is_the_same_run_to_the_last_bit(monkeypatch):
+    # the fixed-step simulator runs CHUNK_STEPS steps per call, the last chunk padded with
+    # zero-length steps: every chunking of a run, and one call for all of it, agree exactly
+    import importlib
+
+    ds = importlib.import_module("derive.simulate")  # the module, not the function
+
+    model = LateralRig() + FixedMass("fixed") + Pendulum("p1") + HingeDamper("p1")
+    params = {"rig.dry_mass": 1.2, "fixed.mass": 1.5, "p1.mass": 1.3, "p1.length": 0.057,
+              "p1.damping": 1e-3}
+    t = np.linspace(0.0, 6.0, 1038)  # 1037 steps: no chunk size below divides it
+    w = 2 * np.pi * 2.1
+    x = np.vstack([0.004 * np.sin(w * t), 0.004 * w * np.cos(w * t),
+                   -0.004 * w**2 * np.sin(w * t)])  # displacement, rate, acceleration
+    runs = []
+    for chunk in (10**6, 64, 100, 1036):
+        monkeypatch.setattr(ds, "CHUNK_STEPS", chunk)
+        runs.append(simulate(model, params, t, Sampled(t, x), integrator=RK4()))
+    for sim in runs[1:]:
+        assert np.array_equal(sim.states, runs[0].states)
+        assert np.array_equal(sim.outputs, runs[0].outputs, equal_nan=True)
+    assert np.max(np.abs(runs[0].states[:, 0])) > 0.05  # the pendulum does swing

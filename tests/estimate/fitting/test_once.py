@@ -28,3 +28,15 @@ def test_outputs_equal_the_functions_at_every_point_and_after_a_revisit():
         np.testing.assert_allclose(np.asarray(a), 2 * np.asarray(fa), rtol=1e-15)
         np.testing.assert_allclose(np.asarray(b), np.asarray(ca.mtimes(fb.T, fb)), rtol=1e-15)
         assert once(p)[1].sparsity() == f.sparsity_out(1)
+
+
+def test_released_buffers_are_made_again_at_the_next_point():
+    f = _wrapped()
+    once = OncePerPoint("once", f)
+    p = np.array([0.3, -1.2, 0.7])
+    first = [np.asarray(v) for v in once(p)]
+    once.release()
+    again = [np.asarray(v) for v in once(p)]  # the same point: recomputed, not stale zeros
+    for a, b, c in zip(first, again, f(p)):
+        np.testing.assert_array_equal(a, b)
+        np.testing.assert_allclose(b, np.asarray(c), rtol=1e-15)
