@@ -25,7 +25,7 @@ import numpy as np
 from derive import DerivedModel, rk4_step
 from derive import compiled as compile_fn
 
-from ._sparse import affine_parameters, scatter
+from ._sparse import affine_parameters, dense_dm, scatter
 
 __all__ = ["condensed_block", "padded_grid", "residual_jacobian", "StepSensitivities"]
 
@@ -244,7 +244,7 @@ class _Windows:
         L = np.zeros((K, nU, m, width))
         r = C.row % (nU * K)
         L[r // nU, r % nU, k, C.col - start[k]] = C.data
-        basis = [ca.DM(L[j].reshape(nU, m * width)) for j in range(K)]
+        basis = [dense_dm(L[j].reshape(nU, m * width)) for j in range(K)]
         return cls(start, width, lo - start, hi - start, basis, nc)
 
     def grid_bases(self, A_grid, nu: int, K: int, n: int):
@@ -264,8 +264,8 @@ class _Windows:
         L = np.zeros((K + 1, nu, m, self.width))  # index K: sample 0
         j = np.where(s > 0, (s - 1) % K, K)
         L[j, C.row % nu, k, c] = C.data
-        steps = [ca.DM(L[i].reshape(nu, m * self.width)) for i in range(K)]
-        return steps, ca.DM(L[K, :, 0, :])
+        steps = [dense_dm(L[i].reshape(nu, m * self.width)) for i in range(K)]
+        return steps, dense_dm(L[K, :, 0, :])
 
     def entries(self, intervals: int, per: int):
         """``(k, i, j)`` index arrays over intervals ``k < intervals``, ``i < per`` and the
