@@ -16,9 +16,9 @@ __all__ = ["OncePerPoint"]
 class OncePerPoint(ca.Callback):
     """``fn`` (one input, a column) as a CasADi callback that keeps its outputs for the
     last input it saw. It evaluates ``fn`` through a :meth:`casadi.Function.buffer`, whose
-    work vector is allocated once: a fresh call allocates it every time (72 MB for a 30,001-
-    sample fit, about 60 ms of page faults per iterate). The Python object must outlive
-    every function that calls it."""
+    work vector is allocated at the first evaluation and kept until :meth:`release`: a
+    fresh call allocates it every time (72 MB for a 30,001-sample fit, about 60 ms of page
+    faults per iterate). The Python object must outlive every function that calls it."""
 
     def __init__(self, name: str, fn: ca.Function) -> None:
         ca.Callback.__init__(self)
@@ -37,6 +37,14 @@ class OncePerPoint(ca.Callback):
         self._buffer = self._evaluate = None
         self._outputs = []
         self._fresh = False
+
+    def _allocate(self) -> None:
+        fn = self._fn
+        self._outputs = [np.zeros(fn.nnz_out(i)) for i in range(fn.n_out())]
+        self._buffer, self._evaluate = fn.buffer()
+        self._buffer.set_arg(0, memoryview(self._point))  # read in place at every call
+        for i, out in enumerate(self._outputs):
+            self._buffer.set_res(i, memoryview(out))
 
     def get_n_in(self) -> int:
         return 1
@@ -60,12 +68,7 @@ class OncePerPoint(ca.Callback):
         w = np.zeros(self._point.size) if arg[0] is None else np.frombuffer(arg[0], float)
         if not (self._fresh and np.array_equal(w, self._point)):
             if self._buffer is None:
-                fn = self._fn
-                self._outputs = [np.zeros(fn.nnz_out(i)) for i in range(fn.n_out())]
-                self._buffer, self._evaluate = fn.buffer()
-                self._buffer.set_arg(0, memoryview(self._point))
-                for i, out in enumerate(self._outputs):
-                    self._buffer.set_res(i, memoryview(out))
+                self._allocate()
             self._point[:] = w
             self._evaluate()
             self._fresh = True
