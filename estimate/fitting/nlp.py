@@ -65,6 +65,8 @@ IPOPT_DEFAULTS = {
     # 11/9/14 -> 6/5/9 on bench_fit's, the same estimates to 1e-6 of their values.
     "ipopt.bound_mult_init_val": 1e-5,
 }
+
+
 @dataclass(frozen=True)
 class Hessian:
     """Hessian of the Lagrangian given to IPOPT: ``"gauss-newton"`` (J_r^T J_r of the
