@@ -61,30 +61,65 @@ def _sensitivity_symbols(dm: DerivedModel, ntheta: int, width: int):
                              ca.SX.sym("Sc", nx, width))
 
 
+def _step_inputs(nU: int, width: int) -> tuple[list[ca.SX], ca.SX]:
+    """A step's input symbols and its stage inputs: ``[U]`` (data), or ``[B, c]`` with
+    ``U = B c`` (an interval's basis over its window of ``width`` coefficients)."""
+    if not width:
+        U = ca.SX.sym("U", nU)
+        return [U], U
+    B, c = ca.SX.sym("B", nU, width), ca.SX.sym("c", width)
+    return [B, c], ca.mtimes(B, c)
+
+
+def _step(dm: DerivedModel, substeps: int, width: int, compiled: bool) -> ca.Function:
+    """One RK4 step ``(x, inputs..., p, t, h) -> x+`` (:func:`_step_inputs`), compiled
+    when asked (then without CasADi derivatives). Built once per model, substeps and
+    width."""
+    key = ("condensed_step", substeps, width, compiled)
+
+    if not width:  # the plain RK4 step, shared with the other transcriptions
+        from .transcription import _compiled_step
+
+        return _compiled_step(dm, substeps) if compiled else rk4_step(dm, substeps)
+
+    def build() -> ca.Function:
+        step = rk4_step(dm, substeps)
+        x = ca.SX.sym("x", dm.nx)
+        ins, U = _step_inputs(step.size1_in(1), width)
+        p = ca.SX.sym("p", step.size1_in(2))
+        t, h = ca.SX.sym("t"), ca.SX.sym("h")
+        fn = ca.Function("condensed_step", [x, *ins, p, t, h], [step(x, U, p, t, h)])
+        return compile_fn(fn) if compiled else fn
+
+    return dm.memo(key, build)
+
+
 def _propagation(dm: DerivedModel, substeps: int, ntheta: int, width: int,
                  compiled: bool) -> ca.Function:
-    """One RK4 step carrying forward sensitivities: ``(x, U, B, p0, vec(S), theta, t, h,
-    Sx, St, Sc) -> (x+, Sx+, St+, Sc+)`` with ``p = p0 + S theta``, ``Sx+ = A Sx``,
-    ``St+ = A St + dx+/dtheta``, ``Sc+ = A Sc + dx+/dU B`` (``A = dx+/dx``): the states'
-    derivatives w.r.t. the interval's node, the scaled parameters and a window of
-    ``width`` coefficients of an estimated input (``U = B c``; ``B`` empty when the inputs
-    are data). Built (and compiled) once per model, substeps, estimates and width."""
+    """One RK4 step carrying forward sensitivities: ``(x, inputs..., p0, vec(S), theta,
+    t, h, Sx, St, Sc) -> (x+, Sx+, St+, Sc+)`` (inputs: :func:`_step_inputs`) with
+    ``p = p0 + S theta``, ``Sx+ = A Sx``, ``St+ = A St + dx+/dtheta``,
+    ``Sc+ = A Sc + dx+/dc`` (``A = dx+/dx``): the states' derivatives w.r.t. the
+    interval's node, the scaled parameters and a window of ``width`` coefficients of an
+    estimated input (``U = B c``; no ``Sc`` columns when the inputs are data). Built (and
+    compiled) once per model, substeps, estimates and width."""
     key = ("condensed_propagation", substeps, ntheta, width, compiled)
 
     def build() -> ca.Function:
         step = rk4_step(dm, substeps)
-        nU, nx = step.size1_in(1), dm.nx
+        nx = dm.nx
         x = ca.SX.sym("x", nx)
-        U = ca.SX.sym("U", nU)
-        B = ca.SX.sym("B", nU, width)
+        ins, U = _step_inputs(step.size1_in(1), width)
         t, h = ca.SX.sym("t"), ca.SX.sym("h")
         (p0, Sv, th), p, (Sx, St, Sc) = _sensitivity_symbols(dm, ntheta, width)
         xn = step(x, U, p, t, h)
         A = ca.jacobian(xn, x)
         outs = [xn, ca.densify(ca.mtimes(A, Sx)),
                 ca.densify(ca.mtimes(A, St) + ca.jacobian(xn, th)),
-                ca.densify(ca.mtimes(A, Sc) + ca.jtimes(xn, U, B)) if width else ca.SX(nx, 0)]
-        fn = ca.Function("condensed_propagation", [x, U, B, p0, Sv, th, t, h, Sx, St, Sc], outs)
+                ca.densify(ca.mtimes(A, Sc) + ca.jacobian(xn, ins[1])) if width
+                else ca.SX(nx, 0)]
+        fn = ca.Function("condensed_propagation", [x, *ins, p0, Sv, th, t, h, Sx, St, Sc],
+                         outs)
         if compiled:
             fn = compile_fn(fn)
         return fn
@@ -101,15 +136,28 @@ def condensed_block(dm: DerivedModel, substeps: int, K: int, p: ca.MX, t: np.nda
 
     Step ``j`` of every interval is one mapped evaluation (``K`` of them in all), so the
     expression graph and the compiled code do not grow with ``K`` or the record."""
-    from .transcription import Block, _bidiagonal, _compiled_step
+    from .transcription import Block, _bidiagonal
 
     n, nx = t.size, dm.nx
     m, tk, hk = padded_grid(t, K)
-    nU = int(U.size1())
-    pad = m * K - (n - 1)
-    Up = ca.horzcat(U, ca.DM.zeros(nU, pad)) if pad else U
-    # step j of every interval: its stage inputs (nU x m), start times and lengths (1 x m)
-    Uj = [Up[:, j::K] for j in range(K)]
+    win = grid_inputs = None
+    if coefficients is not None:
+        # the stage inputs of step j of interval k: its window's basis times the window's
+        # coefficients, inside the step functions (the sparse stage matrix is never made
+        # a CasADi constant, nor the inputs an intermediate)
+        nU = coefficients.rows
+        win = _Windows.of(coefficients.stage, m, nU, K)
+        if win.width > WINDOW_MAX:
+            return None  # inputs not local in their coefficients: a node per sample instead
+        Cw = win.window_coefficients(coefficients.c)
+        inputs = [(win.basis[j], Cw) for j in range(K)]
+    else:
+        nU = int(U.size1())
+        pad = m * K - (n - 1)
+        Up = ca.horzcat(U, ca.DM.zeros(nU, pad)) if pad else U
+        inputs = [(Up[:, j::K],) for j in range(K)]  # step j of every interval: nU x m
+    width = 0 if win is None else win.width
+    # step j of every interval: start times and lengths (1 x m)
     tj = [ca.DM(tk[j::K]).T for j in range(K)]
     hj = [ca.DM(hk[j::K]).T for j in range(K)]
     nodes = np.arange(m) * K
@@ -118,10 +166,12 @@ def condensed_block(dm: DerivedModel, substeps: int, K: int, p: ca.MX, t: np.nda
     N = ca.horzcat(ca.DM(x0), W) if fixed else W  # node states, one column per interval
     w0 = np.asarray(x_guess)[:, nodes[1:] if fixed else nodes]
 
-    def run(step_map) -> list[ca.MX]:  # the states after each step, nx x m each
+    def run(compiled_step: bool) -> list[ca.MX]:  # the states after each step, nx x m each
+        step_map = dm.mapped(("condensed_step", substeps, width, compiled_step),
+                             _step(dm, substeps, width, compiled_step), m)
         xs, x = [], N
         for j in range(K):
-            x = step_map(x, Uj[j], p, tj[j], hj[j])
+            x = step_map(x, *inputs[j], p, tj[j], hj[j])
             xs.append(x)
         return xs
 
@@ -135,26 +185,27 @@ def condensed_block(dm: DerivedModel, substeps: int, K: int, p: ca.MX, t: np.nda
         stacked = ca.vertcat(*[ca.vec(x) for x in xs])
         return ca.horzcat(N[:, 0], ca.reshape(stacked[order], nx, n - 1))
 
+    if win is not None and coefficients.grid is not None:
+        intervals, first = win.grid = win.grid_bases(coefficients.grid, dm.nu, K, n)
+        # samples k K + 1 .. k K + K of interval k in one product: nu K x m, which
+        # reshaped to nu x K m has the samples in order
+        later = ca.reshape(win.product(dm, intervals, Cw, compiled), dm.nu, K * m)
+        grid_inputs = ca.horzcat(ca.mtimes(first, Cw[:, 0]), later[:, : n - 1])
+
     def continuity(last: ca.MX) -> ca.MX:  # node k + 1 = the end of interval k
         return ca.vec(N[:, 1:] - last[:, : m - 1])
 
-    step = rk4_step(dm, substeps)
-    xs = run(dm.mapped(("rk4_step", substeps), step, m))
+    xs = run(False)
     X, g = states(xs), continuity(xs[-1])
     if theta is None:
-        return Block(ca.vec(W), w0.ravel(order="F"), g, X)
+        return Block(ca.vec(W), w0.ravel(order="F"), g, X, grid_inputs=grid_inputs)
     g_fast, X_fast = g, X
     if compiled:  # what IPOPT evaluates: compiled steps (no CasADi derivatives)
-        xs_fast = run(dm.mapped(("rk4_step_compiled", substeps), _compiled_step(dm, substeps), m))
+        xs_fast = run(True)
         g_fast, X_fast = continuity(xs_fast[-1]), states(xs_fast)
     ntheta_all = theta.numel()
     p0, S, cols, theta = _dynamic_parameters(p, theta)
     ntheta = len(cols)
-    win = None if coefficients is None else _Windows.of(
-        coefficients.A if coefficients.A_csc is None else coefficients.A_csc, m, nU, K)
-    if win is not None and win.width > WINDOW_MAX:
-        return None  # inputs not local in their coefficients: a node per sample instead
-    width = 0 if win is None else win.width
     prop = dm.mapped(("condensed_propagation", substeps, ntheta, width, compiled),
                      _propagation(dm, substeps, ntheta, width, compiled), m)
     x = N
@@ -163,8 +214,7 @@ def condensed_block(dm: DerivedModel, substeps: int, K: int, p: ca.MX, t: np.nda
     Sc = ca.DM.zeros(nx, width * m)
     xj, Sxs, Sts, Scs = [], [], [], []
     for j in range(K):
-        Bj = ca.DM(nU, 0) if win is None else win.basis[j]
-        x, Sx, St, Sc = prop(x, Uj[j], Bj, p0, ca.vec(S), theta, tj[j], hj[j], Sx, St, Sc)
+        x, Sx, St, Sc = prop(x, *inputs[j], p0, ca.vec(S), theta, tj[j], hj[j], Sx, St, Sc)
         xj.append(x)
         Sxs.append(Sx)
         Sts.append(St)
@@ -181,7 +231,8 @@ def condensed_block(dm: DerivedModel, substeps: int, K: int, p: ca.MX, t: np.nda
     sens = StepSensitivities(K, m, n, fixed, N, tuple(xj), tuple(Sxs), tuple(Sts),
                              tuple(Scs), win, cols, p0, S, theta)
     return Block(ca.vec(W), w0.ravel(order="F"), g, X, jac_theta, jac_w, g_fast, jac_c,
-                 continuity(xj[-1]), state_jacobian=sens, X_fast=X_fast)
+                 continuity(xj[-1]), state_jacobian=sens, X_fast=X_fast,
+                 grid_inputs=grid_inputs)
 
 
 def _dynamic_parameters(p: ca.MX, theta: ca.MX):
@@ -222,6 +273,21 @@ class _Windows:
     def __init__(self, start, width, first, last, basis, n_coefficients):
         self.start, self.width, self.first, self.last = start, width, first, last
         self.basis, self.n_coefficients = basis, n_coefficients
+        #: The grid inputs' bases (:meth:`grid_bases`), when the block made them.
+        self.grid = None
+
+    def window_coefficients(self, c: ca.MX) -> ca.MX:
+        """``width x m``: column ``k`` holds the coefficients of interval ``k``'s window."""
+        idx = self.start[None, :] + np.arange(self.width)[:, None]
+        return ca.reshape(c[idx.ravel(order="F").tolist()], self.width, self.start.size)
+
+    def product(self, dm: DerivedModel, basis: ca.DM, Cw: ca.MX, compiled: bool) -> ca.MX:
+        """Every interval's ``rows x width`` block of ``basis`` (side by side) times its
+        window's coefficients (a column of ``Cw``): ``rows x m``."""
+        rows, m = int(basis.size1()), self.start.size
+        key = ("window_product", rows, self.width, compiled)
+        fn = dm.memo(key, lambda: _window_product(rows, self.width, compiled))
+        return dm.mapped(key, fn, m)(basis, Cw)
 
     @classmethod
     def of(cls, A, m: int, nU: int, K: int) -> "_Windows":
@@ -247,12 +313,13 @@ class _Windows:
         basis = [dense_dm(L[j].reshape(nU, m * width)) for j in range(K)]
         return cls(start, width, lo - start, hi - start, basis, nc)
 
-    def grid_bases(self, A_grid, nu: int, K: int, n: int):
-        """The grid inputs' bases over the windows: per step ``j``, the ``nu x width``
-        blocks of sample ``k K + j + 1`` of every interval ``k`` side by side, and sample
-        0's (interval 0's window). A grid input outside its interval's window is an
-        error (the windows are the stage inputs', whose first and last stage times are
-        the samples)."""
+    def grid_bases(self, A_grid, nu: int, K: int, n: int) -> tuple[ca.MX, ca.DM]:
+        """The grid inputs' bases over the windows: per interval ``k``, the
+        ``nu K x width`` block of its samples ``k K + 1 .. k K + K`` (side by side; rows
+        ``j nu .. (j + 1) nu`` are sample ``k K + j + 1``'s), one constant the block's
+        expressions share; and sample 0's (interval 0's window). A grid input outside its
+        interval's window is an error (the windows are the stage inputs', whose first and
+        last stage times are the samples)."""
         C = _coo(A_grid)
         m = self.start.size
         s = C.row // nu
@@ -264,8 +331,7 @@ class _Windows:
         L = np.zeros((K + 1, nu, m, self.width))  # index K: sample 0
         j = np.where(s > 0, (s - 1) % K, K)
         L[j, C.row % nu, k, c] = C.data
-        steps = [dense_dm(L[i].reshape(nu, m * self.width)) for i in range(K)]
-        return steps, dense_dm(L[K, :, 0, :])
+        return ca.MX(dense_dm(L[:K].reshape(K * nu, m * self.width))), dense_dm(L[K, :, 0, :])
 
     def entries(self, intervals: int, per: int):
         """``(k, i, j)`` index arrays over intervals ``k < intervals``, ``i < per`` and the
@@ -274,6 +340,13 @@ class _Windows:
                                  indexing="ij")
         keep = (J_ >= self.first[K_]) & (J_ <= self.last[K_])
         return K_[keep], I_[keep], J_[keep]
+
+
+def _window_product(rows: int, width: int, compiled: bool) -> ca.Function:
+    """``(B, c) -> B c`` of a ``rows x width`` matrix and a ``width`` column."""
+    B, c = ca.SX.sym("B", rows, width), ca.SX.sym("c", width)
+    fn = ca.Function("window_product", [B, c], [ca.mtimes(B, c)])
+    return compile_fn(fn) if compiled else fn
 
 
 def _coo(A, row_order: bool = False):
@@ -346,16 +419,14 @@ def _output_sensitivity(dm: DerivedModel, channels: tuple[str, ...], ntheta: int
 
 def residual_jacobian(dm: DerivedModel, channels: tuple[str, ...], sens: StepSensitivities,
                       Ug: ca.MX | ca.DM, ntheta_all: int, t: np.ndarray, factor: np.ndarray,
-                      compiled: bool, A_grid=None
-                      ) -> tuple[ca.MX, ca.MX, ca.MX | None]:
+                      compiled: bool) -> tuple[ca.MX, ca.MX, ca.MX | None]:
     """``(d e/d theta, d e/d w, d e/d c)`` of ``e = vec(Y) * factor`` w.r.t. the
     ``ntheta_all`` scaled estimates, the block's nodes and the carriage coefficients
     (``Y`` the measured outputs, samples x channels, channel-major as
     :func:`estimate.fitting.residual_jacobian.force_residual_jacobian`) on a condensed
     block: each sample's output Jacobian composed with its state's sensitivities inside
-    one compiled per-sample function (no sparse products at evaluation). ``A_grid``
-    (CasADi or SciPy, ``vec(Ug) = A_grid c``) gives the grid inputs' coefficients when
-    the inputs are estimated."""
+    one compiled per-sample function (no sparse products at evaluation). When the inputs
+    are estimated, their bases over the windows are the block's (``sens.windows.grid``)."""
     K, m, n, nx, nu, nch = sens.K, sens.m, sens.n, dm.nx, dm.nu, len(channels)
     win = sens.windows
     width = 0 if win is None else win.width
@@ -366,11 +437,13 @@ def residual_jacobian(dm: DerivedModel, channels: tuple[str, ...], sens: StepSen
     pad = m * K + 1 - n
     Ugp = ca.horzcat(Ug, ca.DM.zeros(nu, pad)) if pad else Ug
     tp = np.r_[t, np.full(pad, t[-1])]
-    bases = (None if win is None else
-             win.grid_bases(A_grid, nu, K, n))  # step j's (nu x width m), sample 0's
+    if win is not None and win.grid is None:
+        raise ValueError("the condensed block of an estimated input made no grid bases "
+                         "(InputCoefficients.grid missing)")
+    bases = None if win is None else win.grid  # all steps' (nu K x width m), sample 0's
     outs = []
     for j in range(K):
-        Bg = ca.DM(nu, 0) if win is None else bases[0][j]
+        Bg = ca.DM(nu, 0) if win is None else bases[0][j * nu:(j + 1) * nu, :]
         outs.append(fmap(sens.states[j], Ugp[:, j + 1::K], Bg, p0, ca.vec(S), theta,
                          ca.DM(tp[j + 1::K]).T, sens.Sx[j], sens.St[j], sens.Sc[j]))
     # sample 0: at node 0, whose sensitivities are the identity and zeros

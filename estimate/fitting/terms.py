@@ -136,11 +136,11 @@ def case_terms(problem: FitProblem, i: int, theta_s: ca.MX, transcription: Trans
                              f"{', '.join(_CARRIAGE_INPUTS)}; the model takes {', '.join(dm.inputs)}")
         c = ca.MX.sym(f"carriage{i}", carriage.n_coefficients)
         fr = transcription.fractions()
-        A_stage, A_grid, B0 = carriage.casadi_matrices(t, fr)
-        U = ca.reshape(ca.mtimes(A_stage, c), dm.nu * fr.size, n - 1)
-        Ug = ca.reshape(ca.mtimes(A_grid, c), dm.nu, n)
         S_stage, S_grid = carriage.scipy_matrices(t, fr)
-        coefficients = InputCoefficients(c, A_stage, S_stage)
+        # the stage inputs U are the transcription's to make from the coefficients
+        U, Ug = None, None
+        coefficients = InputCoefficients(c, S_stage, dm.nu * fr.size, S_grid,
+                                         lambda: carriage.casadi_matrix(t, fr, "stage"))
         coef0 = carriage.coefficients
         lag0 = _lag_value(problem, i)
         if warm is not None and warm.carriage is not None and warm.carriage.size == coef0.size:
@@ -168,6 +168,10 @@ def case_terms(problem: FitProblem, i: int, theta_s: ca.MX, transcription: Trans
     x0 = np.zeros(dm.nx) if initial_state == "rest" else None
     block = transcription.block(dm, p_i, t, U, guess, x0, theta=theta_s if blocks_ok else None,
                                 compiled=compile_, coefficients=coefficients)
+    if carriage is not None:
+        Ug = block.grid_inputs
+        if Ug is None:
+            Ug = ca.reshape(ca.mtimes(carriage.casadi_matrix(t, fr, "grid"), c), dm.nu, n)
     if initial_state == "steady" and dm.nx:
         u0 = excitation.values(t[:1]) if dm.nu else np.zeros((0, 1))
         block = steady_start(block, dm, p_i, theta_s, np.asarray(u0).ravel(), float(t[0]),
@@ -212,7 +216,7 @@ def case_terms(problem: FitProblem, i: int, theta_s: ca.MX, transcription: Trans
     lag = _stream_lag(problem, i, theta_s)
     if carriage is not None:
         if lag is None:
-            shifted = B0
+            shifted = carriage.casadi_matrix(t, transcription.fractions(), "displacement")
         else:  # the recorded displacement is the spline `lag` later: its Taylor series
             designs = carriage.derivative_designs(t, lag[2].order)
             shifted = sum((lag[0] ** d * designs[d] for d in range(1, len(designs))), designs[0])
@@ -227,12 +231,12 @@ def case_terms(problem: FitProblem, i: int, theta_s: ca.MX, transcription: Trans
             from .condensed import residual_jacobian
 
             jt, jx, jc = residual_jacobian(dm, chans, block.state_jacobian, Ug,
-                                           theta_s.numel(), t, factor, compile_,
-                                           None if carriage is None else S_grid)
+                                           theta_s.numel(), t, factor, compile_)
         else:
             jt, jx, jc = force_residual_jacobian(
                 dm, chans, block.X, Ug, p_i, theta_s, t, factor, initial_state == "rest",
-                compile_, None if carriage is None else A_grid)
+                compile_, None if carriage is None
+                else carriage.casadi_matrix(t, transcription.fractions(), "grid"))
         if extras:
             ye = sum(extras[1:], extras[0])
             if ye.shape != Y.shape:  # a term of one column added to every channel
