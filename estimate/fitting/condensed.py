@@ -189,7 +189,8 @@ def condensed_block(dm: DerivedModel, substeps: int, K: int, p: ca.MX, t: np.nda
         intervals, first = win.grid = win.grid_bases(coefficients.grid, dm.nu, K, n)
         # samples k K + 1 .. k K + K of interval k in one product: nu K x m, which
         # reshaped to nu x K m has the samples in order
-        later = ca.reshape(win.product(dm, intervals, Cw, compiled), dm.nu, K * m)
+        # (interpreted: measurement terms of the inputs are differentiated through it)
+        later = ca.reshape(win.product(dm, intervals, Cw), dm.nu, K * m)
         grid_inputs = ca.horzcat(ca.mtimes(first, Cw[:, 0]), later[:, : n - 1])
 
     def continuity(last: ca.MX) -> ca.MX:  # node k + 1 = the end of interval k
@@ -281,12 +282,12 @@ class _Windows:
         idx = self.start[None, :] + np.arange(self.width)[:, None]
         return ca.reshape(c[idx.ravel(order="F").tolist()], self.width, self.start.size)
 
-    def product(self, dm: DerivedModel, basis: ca.DM, Cw: ca.MX, compiled: bool) -> ca.MX:
+    def product(self, dm: DerivedModel, basis: ca.MX, Cw: ca.MX) -> ca.MX:
         """Every interval's ``rows x width`` block of ``basis`` (side by side) times its
         window's coefficients (a column of ``Cw``): ``rows x m``."""
         rows, m = int(basis.size1()), self.start.size
-        key = ("window_product", rows, self.width, compiled)
-        fn = dm.memo(key, lambda: _window_product(rows, self.width, compiled))
+        key = ("window_product", rows, self.width)
+        fn = dm.memo(key, lambda: _window_product(rows, self.width))
         return dm.mapped(key, fn, m)(basis, Cw)
 
     @classmethod
@@ -342,11 +343,10 @@ class _Windows:
         return K_[keep], I_[keep], J_[keep]
 
 
-def _window_product(rows: int, width: int, compiled: bool) -> ca.Function:
+def _window_product(rows: int, width: int) -> ca.Function:
     """``(B, c) -> B c`` of a ``rows x width`` matrix and a ``width`` column."""
     B, c = ca.SX.sym("B", rows, width), ca.SX.sym("c", width)
-    fn = ca.Function("window_product", [B, c], [ca.mtimes(B, c)])
-    return compile_fn(fn) if compiled else fn
+    return ca.Function("window_product", [B, c], [ca.mtimes(B, c)])
 
 
 def _coo(A, row_order: bool = False):
