@@ -134,11 +134,23 @@ CHUNK_STEPS = 1024
 def _rk4_run(dm: DerivedModel, exc: Excitation, substeps: int, outputs: tuple[int, ...],
              compile_: bool, x0: np.ndarray, U: np.ndarray, p: np.ndarray, t: np.ndarray,
              h: np.ndarray, Ug: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
-    """States ``(nx, len(t))`` and outputs of a fixed-step run, :data:`CHUNK_STEPS` steps
-    per call of :func:`_simulator` (arguments as it takes them, unshaped)."""
-    n = h.size
+    """States ``(nx, runs, len(t))`` and outputs ``(outputs, runs, len(t))`` of fixed-step
+    runs under the same inputs, one per column of ``x0`` (``nx x runs``) and ``p``
+    (``parameters x runs``), :data:`CHUNK_STEPS` steps per call of :func:`_simulator`
+    (mapped over the runs, the inputs shared; other arguments as it takes them)."""
+    n, runs = h.size, p.shape[1]
     c = min(n, CHUNK_STEPS)
     fn = _simulator(dm, exc, substeps, c, outputs, compile_)
+    if runs > 1:
+        key = ("sim runs", exc if exc.analytic else None, substeps, c, outputs, compile_, runs)
+        # inputs U, t, h and Ug are the same for every run: passed once, not repeated
+        fn = dm.memo(key, lambda: fn.map("runs", "serial", runs, [1, 3, 4, 5], []))
+    # evaluated through a buffer: arguments read from and results written to NumPy
+    # arrays in place (a DM result's conversion took as long as the runs)
+    buffer, evaluate = fn.buffer()
+    results = [np.empty(fn.nnz_out(i)) for i in range(2)]
+    for i, r in enumerate(results):
+        buffer.set_res(i, memoryview(r))
     Xs, Ys, x = [], [], x0
     for k0 in range(0, n, c):
         k = min(c, n - k0)  # real steps in this chunk
@@ -148,13 +160,19 @@ def _rk4_run(dm: DerivedModel, exc: Excitation, substeps: int, outputs: tuple[in
             Uk = np.hstack([Uk, np.repeat(Uk[:, -1:], pad, axis=1)])
             Ugk = np.hstack([Ugk, np.repeat(Ugk[:, -1:], pad, axis=1)])
             hk, tk = np.r_[hk, np.zeros(pad)], np.r_[tk, np.full(pad, tk[-1])]
-        X, Y = fn(x, Uk, p, tk.reshape(1, -1), hk.reshape(1, -1), Ugk)
-        X, Y = np.asarray(X), np.asarray(Y)
+        # column-major values, kept referenced until the evaluation
+        args = [np.asarray(a, float).ravel(order="F") for a in (x, Uk, p, tk, hk, Ugk)]
+        for i, a in enumerate(args):
+            buffer.set_arg(i, memoryview(a))
+        evaluate()
+        # the runs' results side by side: (rows, runs * (c + 1)), column-major
+        X = results[0].reshape(runs, c + 1, -1).transpose(2, 0, 1)
+        Y = results[1].reshape(runs, c + 1, -1).transpose(2, 0, 1)
         first = 0 if k0 == 0 else 1  # the previous chunk gave this chunk's first sample
-        Xs.append(X[:, first:k + 1])
-        Ys.append(Y[:, first:k + 1])
-        x = X[:, k]
-    return np.hstack(Xs), np.hstack(Ys)
+        Xs.append(X[:, :, first:k + 1].copy())
+        Ys.append(Y[:, :, first:k + 1].copy())
+        x = X[:, :, k].copy()
+    return np.concatenate(Xs, axis=2), np.concatenate(Ys, axis=2)
 
 
 def _build_simulator(dm: DerivedModel, exc: Excitation, substeps: int, n: int,
@@ -296,7 +314,9 @@ def simulate(
         s = integrator.substeps
         h = np.diff(t)
         U, Ug = _sampled_inputs(dm, exc, t, s)
-        X, Y = _rk4_run(dm, exc, s, idx, integrator.compiled, x_init, U, p, t, h, Ug)
+        X, Y = _rk4_run(dm, exc, s, idx, integrator.compiled, x_init[:, None], U, p[:, None],
+                        t, h, Ug)
+        X, Y = X[:, 0], Y[:, 0]
     elif isinstance(integrator, Adaptive):
         X = _adaptive(dm, integrator, exc, x_init, p, t)
         Ug = exc.values(t).reshape(dm.nu, t.size)
@@ -311,15 +331,18 @@ def simulate(
 
 def simulate_outputs(model: DerivedModel | Model, params: Sequence[Mapping[str, float]],
                      t: np.ndarray, excitation: Excitation | None = None, *,
-                     outputs: tuple[str, ...], substeps: int = 1) -> np.ndarray:
+                     outputs: tuple[str, ...], substeps: int = 1,
+                     compiled: bool | None = None) -> np.ndarray:
     """The outputs of one fixed-step RK4 run of ``model`` per parameter set of ``params``,
     all from rest at ``t[0]`` under the same ``excitation``: what :func:`simulate` with
     ``RK4(substeps)`` gives for each, as one array ``(len(params), len(t),
     len(outputs))`` in the outputs' units.
 
-    The excitation is sampled at the stage times once and the runs are one mapped CasADi
-    call: a scan of 70 trial pendulums on 3001 samples takes 0.4 s, where 70 calls of
-    :func:`simulate` took 1.8 s (most of it sampling the same excitation again).
+    The excitation is sampled at the stage times once and the runs are mapped CasADi
+    calls, :data:`CHUNK_STEPS` steps at a time (the runs' states carried from chunk to
+    chunk), compiled when a C compiler exists: a scan of 70 trial pendulums on 3001
+    samples took 0.4 s interpreted, where 70 calls of :func:`simulate` took 1.8 s (most of
+    it sampling the same excitation again).
 
     Parameters
     ----------
@@ -335,6 +358,9 @@ def simulate_outputs(model: DerivedModel | Model, params: Sequence[Mapping[str, 
         Output channels (:data:`derive.OUTPUT_NAMES`); their parameters must have values.
     substeps : int, default 1
         RK4 steps per output interval.
+    compiled : bool, optional
+        Run compiled C (:data:`CHUNK_STEPS` steps per function, compiled once per model,
+        outputs and substeps and cached on disk). Default: when a C compiler exists.
     """
     dm, t, exc = _arguments(model, t, excitation)
     RK4(substeps)  # checks substeps
@@ -343,10 +369,12 @@ def simulate_outputs(model: DerivedModel | Model, params: Sequence[Mapping[str, 
     P = np.column_stack([dm.parameter_vector(p, outputs=outputs) for p in params])
     idx = tuple(dm.output_index(nm) for nm in outputs)
     U, Ug = _sampled_inputs(dm, exc, t, substeps)
-    fn = _simulator(dm, exc, substeps, t.size - 1, idx, False).map(P.shape[1])
-    _, Y = fn(np.zeros(dm.nx), U, P, t.reshape(1, -1), np.diff(t).reshape(1, -1), Ug)
-    # the mapped outputs are side by side: (outputs, runs * samples)
-    Y = np.asarray(Y).reshape(len(outputs), P.shape[1], t.size)
+    if compiled is None:
+        from ._compile import c_compiler
+
+        compiled = c_compiler() is not None
+    _, Y = _rk4_run(dm, exc, substeps, idx, compiled, np.zeros((dm.nx, P.shape[1])), U, P, t,
+                    np.diff(t), Ug)
     return np.ascontiguousarray(Y.transpose(1, 2, 0))
 
 

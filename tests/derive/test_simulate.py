@@ -17,7 +17,7 @@ from analogs import (
     SphericalPendulum,
     SuspendedMass,
 )
-from derive import RK4, Adaptive, NoExcitation, Sampled, Sine, derive, simulate
+from derive import RK4, Adaptive, NoExcitation, Sampled, Sine, c_compiler, derive, simulate
 
 G = 9.80665
 TIGHT = Adaptive(rtol=1e-12, atol=1e-14)
@@ -194,10 +194,13 @@ def test_excitation_size_mismatch_and_bad_grid_are_reported():
         simulate(dm, vals, np.array([0.0, 0.0, 1.0]))
 
 
-@pytest.mark.parametrize("sampled", [False, True])
-def test_simulate_outputs_is_simulate_per_parameter_set(sampled):
+@pytest.mark.parametrize("sampled, compiled, chunk", [(False, False, None), (True, False, None),
+                                                      (True, True, 64), (False, True, 150)])
+def test_simulate_outputs_is_simulate_per_parameter_set(sampled, compiled, chunk, monkeypatch):
     """The batched runs are, set by set and output by output, the RK4 runs of ``simulate``
-    (same arithmetic: equal to rounding); a wrong ordering of the mapped columns (runs and
+    (same arithmetic: equal to rounding), compiled or not and in chunks that do not divide
+    the run (the runs' states carried from chunk to chunk); a wrong ordering of the mapped
+    columns (runs and
     samples interleaved) would swap the pendulums' responses."""
     from derive import simulate_outputs
 
@@ -209,7 +212,13 @@ def test_simulate_outputs_is_simulate_per_parameter_set(sampled):
              "q.hinge_height": 0.05}
             for m, L, c in ((1.0, 0.08, 1e-3), (0.4, 0.02, 0.0), (2.0, 0.15, 5e-3))]
     outputs = ("force_x", "torque_y")
-    got = simulate_outputs(model, sets, t, exc, outputs=outputs, substeps=2)
+    if compiled and c_compiler() is None:
+        pytest.skip("no C compiler")
+    if chunk is not None:
+        import importlib
+
+        monkeypatch.setattr(importlib.import_module("derive.simulate"), "CHUNK_STEPS", chunk)
+    got = simulate_outputs(model, sets, t, exc, outputs=outputs, substeps=2, compiled=compiled)
     assert got.shape == (3, t.size, 2)
     for k, p in enumerate(sets):
         ref = simulate(model, p, t, exc, integrator=RK4(2), outputs=outputs).outputs
