@@ -215,6 +215,12 @@ class CarriageInput:
         with this object."""
         return self._grid(times, fractions)["scipy"]
 
+    def grid_cache(self, times: np.ndarray, fractions: np.ndarray) -> dict:
+        """What is kept for the sample grid ``times`` and stage ``fractions`` (only the
+        last grid's things are kept: they are large): these matrices, and what a
+        transcription derives from them and may reuse in another fit of the record."""
+        return self._grid(times, fractions)
+
     def _grid(self, times: np.ndarray, fractions: np.ndarray) -> dict:
         """The matrices of one sample grid (only the last grid's are kept: they are
         large)."""

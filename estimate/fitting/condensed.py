@@ -146,7 +146,10 @@ def condensed_block(dm: DerivedModel, substeps: int, K: int, p: ca.MX, t: np.nda
         # coefficients, inside the step functions (the sparse stage matrix is never made
         # a CasADi constant, nor the inputs an intermediate)
         nU = coefficients.rows
-        win = _Windows.of(coefficients.stage, m, nU, K)
+        key = ("condensed windows", m, nU, K)
+        if key not in coefficients.cache:
+            coefficients.cache[key] = _Windows.of(coefficients.stage, m, nU, K)
+        win = coefficients.cache[key]
         if win.width > WINDOW_MAX:
             return None  # inputs not local in their coefficients: a node per sample instead
         Cw = win.window_coefficients(coefficients.c)
@@ -186,7 +189,9 @@ def condensed_block(dm: DerivedModel, substeps: int, K: int, p: ca.MX, t: np.nda
         return ca.horzcat(N[:, 0], ca.reshape(stacked[order], nx, n - 1))
 
     if win is not None and coefficients.grid is not None:
-        intervals, first = win.grid = win.grid_bases(coefficients.grid, dm.nu, K, n)
+        if win.grid is None:
+            win.grid = win.grid_bases(coefficients.grid, dm.nu, K, n)
+        intervals, first = win.grid
         # samples k K + 1 .. k K + K of interval k in one product: nu K x m, which
         # reshaped to nu x K m has the samples in order
         # (interpreted: measurement terms of the inputs are differentiated through it)

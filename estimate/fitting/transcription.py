@@ -81,6 +81,10 @@ class InputCoefficients:
     rows: int
     grid: object = None
     _casadi: Callable[[], ca.DM] | None = field(default=None, compare=False, repr=False)
+    #: Kept with the record (:meth:`CarriageInput.grid_cache`): what a transcription
+    #: derives from ``stage`` and ``grid`` for one fit and may reuse in the next (the
+    #: diagnosis assembles a record's NLP ten times).
+    cache: dict = field(default_factory=dict, compare=False, repr=False)
 
     @property
     def A(self) -> ca.DM:

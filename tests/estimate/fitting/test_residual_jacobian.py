@@ -15,7 +15,7 @@ from synthetic_cases import make_case, pendulum
 
 from estimate import FitProblem, model_from_spec
 from estimate.fitting.assembly import assemble_nlp as _setup
-from estimate.fitting.measurement import SensorDelay, SensorOffset
+from estimate.fitting.measurement import RigFriction, SensorDelay, SensorOffset
 from estimate.fitting.transcription import MultipleShooting
 
 
@@ -34,6 +34,7 @@ VARIANTS = {
     "filtered rest": (1, "fixed,p1", "filtered", (), "rest"),
     "two pendulums": (1, "fixed,p1,p2", "estimated", (), "rest"),
     "offset and drift": (1, "fixed,p1", "estimated", (SensorOffset(),), "rest"),
+    "rig friction": (1, "fixed,p1", "estimated", (RigFriction(),), "rest"),
     "delay weights": (1, "fixed,p1", "estimated", (SensorDelay(0.05),), "free"),
     "two cases": (2, "fixed,p1", "estimated", (), "rest"),
 }
@@ -55,6 +56,7 @@ def test_assembled_residual_jacobian_equals_automatic_differentiation(cases, var
     assert all(t.jacobian is not None for t in terms)  # the assembled path is the one tested
     f = ca.Function("f", [nlp.w], [nlp.jac_r, ca.jacobian(nlp.r, nlp.w)])
     w = nlp.w0 * (1 + 0.05 * np.random.default_rng(3).standard_normal(nlp.w0.size))
+    w[: len(problem.estimated)] += 0.1  # no estimate at 0 (a friction's: its terms vanish)
     assembled, automatic = (np.asarray(m.full()) for m in f(w))
     # the same derivatives by two routes: equal to rounding (relative 1e-12 of the largest)
     assert np.max(np.abs(assembled - automatic)) <= 1e-12 * np.max(np.abs(automatic))
