@@ -4,9 +4,10 @@ The fit is what needs memory: a multiple-shooting NLP holds states, Jacobian blo
 IPOPT's factorisation for every sample. Its peak resident memory grows by 9-13 KiB per
 sample for the baseline model with an estimated carriage motion
 (``benchmarks/bench_length.py``: 30,001, 120,001 and 600,001 samples peak at 0.48, 1.2 and
-6.4 GB); :data:`FIT_BYTES_PER_SAMPLE` rounds that up for larger models. A record needing more than the budget is refused with the number of
-samples it holds and by how much to decimate it; slosh modes lie below about 10 Hz, so a
-few hundred samples per second are plenty.
+6.4 GB); :data:`FIT_BYTES_PER_SAMPLE` rounds that up for larger models. A record needing
+more than the budget is refused with the number of samples it holds and by how much to
+decimate it; slosh modes lie below about 10 Hz, so a few hundred samples per second are
+plenty.
 """
 
 from __future__ import annotations

@@ -300,22 +300,31 @@ class _Windows:
         """Windows of the ``m`` intervals of ``K`` steps of ``nU`` stage inputs each,
         ``vec(U) = A c`` (``A`` CasADi or SciPy; its rows past its end: the padded steps,
         zero)."""
-        C = _coo(A, row_order=True)  # entries in row order: intervals ascending
-        nc = C.shape[1]
-        k = C.row // (nU * K)
+        C, row = _rows(A)
+        nc, per = C.shape[1], nU * K  # stage-input rows per interval
         lo = np.zeros(m, dtype=np.int64)
         hi = np.zeros(m, dtype=np.int64)
-        if k.size:
-            present, first = np.unique(k, return_index=True)
-            lo[present] = np.minimum.reduceat(C.col, first)
-            hi[present] = np.maximum.reduceat(C.col, first)
+        # each row's first and last column (sorted within rows), then each interval's
+        full = np.flatnonzero(np.diff(C.indptr))
+        if full.size:
+            k = full // per
+            present, first = np.unique(k, return_index=True)  # rows ascending: k sorted
+            lo[present] = np.minimum.reduceat(C.indices[C.indptr[full]], first)
+            hi[present] = np.maximum.reduceat(C.indices[C.indptr[full + 1] - 1], first)
         # a multiple of 4: fewer distinct compiled functions over records (zero columns)
         width = int(min(nc, -(-int((hi - lo).max() + 1) // 4) * 4))
         start = np.clip(lo, 0, nc - width)
-        # per step j: the (nU x width) bases of every interval side by side
+        # per step j: the (nU x width) bases of every interval side by side; entry of row
+        # r = k per + w (w = j nU + i) and column c at ((w m + k) width + c - start[k])
+        k = row // per
+        flat = row - k * per
+        flat *= m
+        flat += k
+        flat *= width
+        flat += C.indices
+        flat -= start[k]
         L = np.zeros((K, nU, m, width))
-        r = C.row % (nU * K)
-        L[r // nU, r % nU, k, C.col - start[k]] = C.data
+        L.ravel()[flat] = C.data
         basis = [dense_dm(L[j].reshape(nU, m * width)) for j in range(K)]
         return cls(start, width, lo - start, hi - start, basis, nc)
 
@@ -326,18 +335,21 @@ class _Windows:
         expressions share; and sample 0's (interval 0's window). A grid input outside its
         interval's window is an error (the windows are the stage inputs', whose first and
         last stage times are the samples)."""
-        C = _coo(A_grid)
-        m = self.start.size
-        s = C.row // nu
-        k = np.where(s > 0, (s - 1) // K, 0)
-        c = C.col - self.start[k]
-        if np.any((c < 0) | (c >= self.width)):
+        C, row = _rows(A_grid)  # row s nu + i: input i at sample s
+        m, width = self.start.size, self.width
+        late = row >= nu  # samples after the first: sample k K + j + 1 is interval k's
+        k = np.where(late, (row - nu) // (K * nu), 0)
+        c = C.indices - self.start[k]
+        if np.any((c < 0) | (c >= width)):
             raise ValueError("a grid input depends on a carriage coefficient outside its "
                              "interval's window")
-        L = np.zeros((K + 1, nu, m, self.width))  # index K: sample 0
-        j = np.where(s > 0, (s - 1) % K, K)
-        L[j, C.row % nu, k, c] = C.data
-        return ca.MX(dense_dm(L[:K].reshape(K * nu, m * self.width))), dense_dm(L[K, :, 0, :])
+        # row j nu + i = row - nu - k K nu of interval k's block, column c of its window
+        L = np.zeros((K * nu, m, width))
+        rl, kl = row[late], k[late]
+        L.ravel()[((rl - nu - kl * K * nu) * m + kl) * width + c[late]] = C.data[late]
+        first = np.zeros((nu, width))
+        first[row[~late], c[~late]] = C.data[~late]
+        return ca.MX(dense_dm(L.reshape(K * nu, m * width))), dense_dm(first)
 
     def entries(self, intervals: int, per: int):
         """``(k, i, j)`` index arrays over intervals ``k < intervals``, ``i < per`` and the
@@ -354,15 +366,18 @@ def _window_product(rows: int, width: int) -> ca.Function:
     return ca.Function("window_product", [B, c], [ca.mtimes(B, c)])
 
 
-def _coo(A, row_order: bool = False):
-    """A CasADi or SciPy sparse matrix as SciPy COO (entries by rows with ``row_order``)
-    with its structural zeros."""
+def _rows(A):
+    """A CasADi or SciPy sparse matrix as SciPy CSR with sorted column indices, and the
+    row of each entry."""
     import scipy.sparse as sps
 
     from ._sparse import scipy_csc
 
-    C = A if sps.issparse(A) else scipy_csc(A)
-    return (C.tocsr() if row_order else C).tocoo()
+    C = sps.csr_matrix(A if sps.issparse(A) else scipy_csc(A))
+    if not C.has_sorted_indices:
+        C = C.sorted_indices()
+    row = np.repeat(np.arange(C.shape[0], dtype=np.int64), np.diff(C.indptr))
+    return C, row
 
 
 @dataclass(frozen=True)
