@@ -266,8 +266,10 @@ def estimates(names: Sequence[str], params: Mapping, args: Arguments, start: Map
     for n in names:
         p = params[n]
         lo, hi = p.lower, p.upper
+        band = False
         if n.endswith(".length") and n in predicted and n not in args.bounds:
             lo, hi = length_bounds(predicted[n])
+            band = True
             notes.append(f"`{n}` bounded to +/-20 % of the predicted {predicted[n]:.4g} m")
             if n in stage_start and not lo < stage_start[n] < hi:
                 # the anchor stays (a length pinned at it is the diagnosis's evidence of
@@ -288,7 +290,7 @@ def estimates(names: Sequence[str], params: Mapping, args: Arguments, start: Map
             x0_i = x0
             if n == "rig.lag" and stage is not None and n not in given:
                 x0_i = min(max(stage.lags[i], lo), hi)
-            est.append(Estimated(label, n, i, p.unit, x0_i, lo, hi, scale))
+            est.append(Estimated(label, n, i, p.unit, x0_i, lo, hi, scale, band))
     return est
 
 

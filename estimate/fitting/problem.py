@@ -38,7 +38,14 @@ PER_CASE = ("rig.omega_correction", "rig.flywheel_angle")
 class Estimated:
     """One estimated parameter: ``name`` (with ``"<case id>:"`` prefix for per-case ones),
     the model parameter it sets, its case index (``None`` when shared), unit, initial
-    value, bounds and scale."""
+    value, bounds and scale.
+
+    ``band``: the bounds are a plausibility band around a prediction (a pendulum length's
+    +/-20 %), not limits of the physics. A physical bound can be the truth (no hinge
+    spring without a diaphragm), so an estimate on it is held there in the covariance; an
+    estimate on a band's edge is not, or the others' intervals would be conditional on a
+    value nothing supports (a spring that took up the frequency a length pinned at the
+    band left: 0.202 +/- 0.002 N m/rad for a true 0)."""
 
     name: str
     parameter: str
@@ -48,6 +55,7 @@ class Estimated:
     lower: float
     upper: float
     scale: float
+    band: bool = False
 
 
 @dataclass(frozen=True)
@@ -247,9 +255,7 @@ class FitProblem:
     def with_initial(self, values: Mapping[str, float]) -> "FitProblem":
         """A copy with other initial values for some estimated parameters (by label)."""
         est = tuple(
-            Estimated(e.name, e.parameter, e.case, e.unit,
-                      min(max(float(values.get(e.name, e.initial)), e.lower), e.upper),
-                      e.lower, e.upper, e.scale)
+            replace(e, initial=min(max(float(values.get(e.name, e.initial)), e.lower), e.upper))
             for e in self.estimated)
         return replace(self, estimated=est)
 

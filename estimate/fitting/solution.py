@@ -6,7 +6,7 @@ from __future__ import annotations
 
 import math
 import time
-from dataclasses import dataclass
+from dataclasses import dataclass, replace
 
 import numpy as np
 import scipy.sparse as sps
@@ -103,9 +103,18 @@ def fit_result(problem: FitProblem, solve: Solve) -> FitResult:
     samples = [np.r_[np.tile(np.arange(np.shape(m)[0]), c),
                      np.full(0 if x is None else x.size, -1)]
                for m, c, x in zip(measured, nch, displacement_residuals)]
+    # an estimate on a band's edge is not held (Estimated.band): the others' covariance
+    # allows for it, and its spread away from the edge is its own standard error
+    held = np.array([bool(side) and not x.band for side, x in zip(at_bound, problem.estimated)])
     unc = uncertainty(Je, Jg, e, n_force + n_disp, theta.size,
                       np.array([x.scale for x in problem.estimated]), problem.names,
-                      held=tuple(i for i, side in enumerate(at_bound) if side), samples=samples)
+                      held=tuple(np.flatnonzero(held)), samples=samples)
+    edge = [i for i, side in enumerate(at_bound) if side and not held[i]]
+    if edge:
+        spread = np.full(theta.size, np.nan) if unc.bound_stderr is None else unc.bound_stderr.copy()
+        c = unc.robust if unc.robust is not None else unc.covariance
+        spread[edge] = np.sqrt(np.clip(np.diag(c)[edge], 0, None))
+        unc = replace(unc, bound_stderr=spread)
     active = tuple(b for b in problem.linear_bounds if _on_linear_bound(b, problem, theta))
     if active:
         unc = _held_on(unc, np.array([b.row(problem.names) for b in active]))
@@ -120,7 +129,12 @@ def fit_result(problem: FitProblem, solve: Solve) -> FitResult:
         hint = _IPOPT_HINTS.get(status, "see IPOPT's status; try other initial values")
         warnings.append(f"IPOPT did not converge ({status}): {hint}")
     for x, v, side in zip(problem.estimated, theta, at_bound):
-        if side:
+        if side and x.band:
+            warnings.append(f"`{x.name}` = {v:.6g} {x.unit} is at the edge of its band "
+                            f"[{x.lower:.6g}, {x.upper:.6g}] around the prediction: the data "
+                            "do not place it inside; the other intervals allow for its "
+                            "freedom (not held there)")
+        elif side:
             warnings.append(f"`{x.name}` = {v:.6g} {x.unit} is at its bound "
                             f"[{x.lower:.6g}, {x.upper:.6g}]: no standard error, held there in "
                             "the covariance")
@@ -140,7 +154,7 @@ def fit_result(problem: FitProblem, solve: Solve) -> FitResult:
     cov = unc.robust if unc.robust is not None else unc.covariance
     free = np.array([side is None for side in at_bound])
     stderr = np.where(free, np.sqrt(np.clip(np.diag(cov), 0, None)), np.nan)
-    derived, derived_units = derived_quantities(problem, theta, cov, free)
+    derived, derived_units = derived_quantities(problem, theta, cov, ~held)
     pieces = np.split(raw, np.cumsum([int(np.size(m)) for m in measured])[:-1])
     residuals = tuple(p if np.ndim(m) == 1 else p.reshape(m.shape, order="F")
                       for p, m in zip(pieces, measured))
@@ -153,7 +167,7 @@ def fit_result(problem: FitProblem, solve: Solve) -> FitResult:
         if kind == "robust":
             cov = robust
             stderr = np.where(free, np.sqrt(np.clip(np.diag(cov), 0, None)), np.nan)
-            derived, derived_units = derived_quantities(problem, theta, cov, free)
+            derived, derived_units = derived_quantities(problem, theta, cov, ~held)
     return FitResult(
         problem=problem,
         values=theta, stderr=stderr, covariance=cov,
@@ -193,7 +207,6 @@ def _held_on(unc, rows: np.ndarray):
     """``unc`` with its covariances (Gauss-Newton and robust) conditioned on the active
     linear bounds ``rows``
     (:func:`estimate.fitting.budget.conditioned`), standard errors and correlations anew."""
-    from dataclasses import replace
 
     from .budget import conditioned
 

@@ -76,6 +76,30 @@ def spinning_case_with_prediction(tmp_path):
                       prediction=PREDICTION_60)
 
 
+def test_a_length_on_its_prediction_band_is_not_held_in_the_others_intervals(tmp_path):
+    """A free surface (no hinge spring) driven lightly near resonance: the lateral force
+    fixes the frequency, not the length and the spring apart (g/L + k/(m L^2)). This record
+    puts the length on the upper edge of its +/-20 % band with the spring at 0.2 N m/rad
+    taking up the frequency. The band is not physics: held there, it made the spring
+    0.202 +/- 0.002 (90 standard errors from the true 0). Not held, the spring's 95 %
+    interval holds 0, the pair is named unidentifiable, and the frequency, which the data
+    do fix, keeps a standard error under 0.1 % of itself."""
+    case, _ = make_case(tmp_path, "E", ref.Ramped(ref.Sine(0.0002, 2.0), 1.0, 0.0),
+                        pendulums=[pendulum()], duration=20.0, rate=100.0, seed=0)
+    res = fit(FitProblem.build(case, model_from_spec("fixed,p1", case)), progress=False)
+    assert res.converged
+    i = res.names.index("p1.length")
+    assert res.at_bound[i] == "upper"  # the case this test is about
+    assert any("edge of its band" in w for w in res.warnings)
+    lo, hi = res.interval("p1.stiffness")
+    assert lo <= 0.0 <= hi
+    lo, hi = res.interval("p1.length")
+    assert lo <= 0.0553 <= hi  # the true length
+    assert any({"p1.length", "p1.stiffness"} <= set(g) for g in res.identifiability.groups)
+    f, se = res.derived["p1.frequency_hz"]
+    assert 0 < se < 1e-3 * f
+
+
 def test_heights_missing_from_the_prediction_come_from_the_tank_analysis(
         spinning_case_with_prediction):
     case = spinning_case_with_prediction
