@@ -193,8 +193,8 @@ def condensed_block(dm: DerivedModel, substeps: int, K: int, p: ca.MX, t: np.nda
             win.grid = win.grid_bases(coefficients.grid, dm.nu, K, n)
         intervals, first = win.grid
         # samples k K + 1 .. k K + K of interval k in one product: nu K x m, which
-        # reshaped to nu x K m has the samples in order
-        # (interpreted: measurement terms of the inputs are differentiated through it)
+        # reshaped to nu x K m has the samples in order (an interpreted product: the
+        # measurement terms of the inputs are differentiated through it)
         later = ca.reshape(win.product(dm, intervals, Cw), dm.nu, K * m)
         grid_inputs = ca.horzcat(ca.mtimes(first, Cw[:, 0]), later[:, : n - 1])
 
