@@ -75,8 +75,6 @@ def _step(dm: DerivedModel, substeps: int, width: int, compiled: bool) -> ca.Fun
     """One RK4 step ``(x, inputs..., p, t, h) -> x+`` (:func:`_step_inputs`), compiled
     when asked (then without CasADi derivatives). Built once per model, substeps and
     width."""
-    key = ("condensed_step", substeps, width, compiled)
-
     if not width:  # the plain RK4 step, shared with the other transcriptions
         from .transcription import _compiled_step
 
@@ -91,7 +89,7 @@ def _step(dm: DerivedModel, substeps: int, width: int, compiled: bool) -> ca.Fun
         fn = ca.Function("condensed_step", [x, *ins, p, t, h], [step(x, U, p, t, h)])
         return compile_fn(fn) if compiled else fn
 
-    return dm.memo(key, build)
+    return dm.memo(("condensed_step", substeps, width, compiled), build)
 
 
 def _propagation(dm: DerivedModel, substeps: int, ntheta: int, width: int,

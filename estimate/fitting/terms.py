@@ -187,9 +187,12 @@ def case_terms(problem: FitProblem, i: int, theta_s: ca.MX, transcription: Trans
         Xy, Ug, p_i, ca.DM(t).T).T
     mvals = {e.parameter: theta_s[j] * e.scale for j, e in enumerate(problem.estimated)
              if e.case in (None, i)}
-    termed = [(mm, x) for mm in problem.measurement
-              if (x := mm.term(Ug, dm.inputs, mvals, t)) is not None]
-    extras = [x for _, x in termed]
+    # the measurement terms of the inputs on the samples as a symbol (their Jacobians
+    # below are taken w.r.t. it), then at the inputs
+    Us = ca.MX.sym("u", dm.nu * n)
+    termed = [x for mm in problem.measurement
+              if (x := mm.term(ca.reshape(Us, dm.nu, n), dm.inputs, mvals, t)) is not None]
+    extras = [ca.substitute(x, Us, ca.vec(Ug)) for x in termed]
     for extra in extras:
         Y = Y + extra
     F, wts = _measured_force(problem, i)
@@ -243,8 +246,7 @@ def case_terms(problem: FitProblem, i: int, theta_s: ca.MX, transcription: Trans
             # the terms differentiated w.r.t. the inputs on the samples as a symbol, then
             # chained with the inputs' (constant) Jacobian: CasADi's AD through the
             # estimated inputs' expression took 1.2 s on a 30,001-sample record
-            Us = ca.MX.sym("u", dm.nu * n)
-            ye = sum(mm.term(ca.reshape(Us, dm.nu, n), dm.inputs, mvals, t) for mm, _ in termed)
+            ye = sum(termed[1:], termed[0])
             if ye.shape != Y.shape:  # a term of one column added to every channel
                 ye = ca.repmat(ye, 1, len(chans)) if ye.size2() == 1 else ca.repmat(ye, n, 1)
             ye = ca.vec(ye) * ca.DM(factor)
