@@ -199,9 +199,10 @@ def test_excitation_size_mismatch_and_bad_grid_are_reported():
 def test_simulate_outputs_is_simulate_per_parameter_set(sampled, compiled, chunk, monkeypatch):
     """The batched runs are, set by set and output by output, the RK4 runs of ``simulate``
     (same arithmetic: equal to rounding), compiled or not and in chunks that do not divide
-    the run (the runs' states carried from chunk to chunk); a wrong ordering of the mapped
-    columns (runs and
-    samples interleaved) would swap the pendulums' responses."""
+    the run (the runs' states carried from chunk to chunk; the references are made in one
+    chunk, before the chunk size is changed, as ``simulate`` shares the chunking); a wrong
+    ordering of the mapped columns (runs and samples interleaved) would swap the
+    pendulums' responses."""
     from derive import simulate_outputs
 
     model = LateralRig() + Pendulum("q") + HingeDamper("q")
@@ -214,14 +215,15 @@ def test_simulate_outputs_is_simulate_per_parameter_set(sampled, compiled, chunk
     outputs = ("force_x", "torque_y")
     if compiled and c_compiler() is None:
         pytest.skip("no C compiler")
+    refs = [simulate(model, p, t, exc, integrator=RK4(2), outputs=outputs).outputs
+            for p in sets]
     if chunk is not None:
         import importlib
 
         monkeypatch.setattr(importlib.import_module("derive.simulate"), "CHUNK_STEPS", chunk)
     got = simulate_outputs(model, sets, t, exc, outputs=outputs, substeps=2, compiled=compiled)
     assert got.shape == (3, t.size, 2)
-    for k, p in enumerate(sets):
-        ref = simulate(model, p, t, exc, integrator=RK4(2), outputs=outputs).outputs
+    for k, ref in enumerate(refs):
         np.testing.assert_allclose(got[k], ref, rtol=1e-12, atol=1e-12 * np.abs(ref).max())
     assert not np.allclose(got[0], got[1])
 
