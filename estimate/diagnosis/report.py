@@ -73,9 +73,10 @@ def _parameter_rows(res: FitResult) -> list[str]:
         se_text = f"{se:.2g}" if res.free[i] else res.uncertainty_text(i)
         rows.append(f"| `{name}` | {v:.5g} | {se_text} | [{lo:.5g}, {hi:.5g}] | {e.unit} |")
     for k, (v, se) in res.derived.items():
-        unit = res.derived_units.get(k, "")
-        rows.append(f"| `{k}` (derived) | {v:.5g} | {se:.2g} | | {unit} |" if se == se
-                    else f"| `{k}` (derived) | {v:.5g} | at a bound | | {unit} |")
+        lo, hi = res.derived_interval(k)
+        band = f"[{lo:.5g}, {hi:.5g}]" if lo == lo and hi == hi else ""
+        rows.append(f"| `{k}` (derived) | {v:.5g} | {f'{se:.2g}' if se == se else 'at a bound'} "
+                    f"| {band} | {res.derived_units.get(k, '')} |")
     return rows
 
 

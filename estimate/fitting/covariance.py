@@ -69,6 +69,15 @@ class Uncertainty:
     identifiability analysis; ``bound_stderr`` gives, for them only, the standard deviation
     of the estimate the data would allow if the bound were lifted (the others re-estimated),
     NaN when the data do not determine it.
+
+    The truth may lie off the bound, inside: the covariance conditional on the bound then
+    states the others too precisely (a spring held at 0 makes a pendulum length take up the
+    spring's share of the frequency, with the length's conditional interval 70 standard
+    errors from the truth). ``bound_reach[:, h]`` is how far the others' estimates move
+    when the held estimate ``h`` moves one ``bound_stderr`` off its bound in the positive
+    direction (its own row: that standard deviation), the others re-estimated: the joint
+    regression of the estimates on the held ones in the covariance without the bounds. The
+    intervals reach that far along it (:mod:`estimate.fitting.intervals`).
     """
 
     covariance: np.ndarray
@@ -83,6 +92,7 @@ class Uncertainty:
     robust: np.ndarray | None = None
     #: The Newey-West bandwidth (lags, samples) of each case's scores.
     bandwidths: tuple[int, ...] = ()
+    bound_reach: np.ndarray | None = None
 
 
 def uncertainty(jac_residuals: sps.spmatrix, jac_constraints: sps.spmatrix,
@@ -122,11 +132,17 @@ def uncertainty(jac_residuals: sps.spmatrix, jac_constraints: sps.spmatrix,
     ident = analyse(cov[np.ix_(free, free)], scales[free], tuple(names[i] for i in free),
                     corr[np.ix_(free, free)])
     bound_se = np.full(ntheta, np.nan)
+    reach = None
     if len(free) < ntheta:
         Xall, _ = _inverse(S)
-        for i in held:
-            if Xall[i, i] < 1 / (10 * _PRIOR_INFORMATION):  # determined by the data
-                bound_se[i] = np.sqrt(sigma2 * Xall[i, i]) * scales[i]
+        h = np.asarray(held, int)
+        spread = np.sqrt(sigma2 * np.diag(Xall)[h]) * scales[h]
+        determined = np.diag(Xall)[h] < 1 / (10 * _PRIOR_INFORMATION)
+        bound_se[h[determined]] = spread[determined]
+        # undetermined ones reach by the prior's spread: far, unless nothing correlates
+        slope = Xall[:, h] @ np.linalg.inv(Xall[np.ix_(h, h)])  # scaled d theta / d theta_h
+        reach = np.zeros((ntheta, ntheta))
+        reach[:, h] = slope * np.outer(scales, spread / scales[h])
     robust, lags = None, ()
     if samples is not None:
         Xs = np.zeros((ntheta, ntheta))  # held parameters: zero rows and columns
@@ -134,7 +150,8 @@ def uncertainty(jac_residuals: sps.spmatrix, jac_constraints: sps.spmatrix,
         robust, lags = robust_covariance(Xs, kkt.effective_jacobian(), residuals, samples,
                                          n_observations / max(n_observations - k, 1))
         robust = robust * np.outer(scales, scales)
-    return Uncertainty(cov, d, corr, sigma2, ident, tuple(warnings), bound_se, robust, lags)
+    return Uncertainty(cov, d, corr, sigma2, ident, tuple(warnings), bound_se, robust, lags,
+                       reach)
 
 
 def robust_covariance(information_inverse: np.ndarray, effective_jacobian: np.ndarray,

@@ -26,22 +26,42 @@ class ResultIntervals:
     :class:`~estimate.fitting.result.FitResult`."""
 
     def interval(self, name: str, level: float = 0.95) -> tuple[float, float]:
-        """The ``level`` (default 0.95) interval of the estimate ``name``: the Wald interval
-        from :attr:`stderr` (the covariance ``covariance_kind`` names; t distribution); for
-        an estimate at a bound the one-sided interval from the bound
-        (:meth:`one_sided_limit`), up to the other bound when the data do not determine
-        it."""
-        from scipy.stats import t as student
-
+        """The ``level`` (default 0.95) interval of the estimate ``name``, within its bounds:
+        the Wald interval from :attr:`stderr` (the covariance ``covariance_kind`` names; t
+        distribution), reaching as far as the estimate moves when the estimates held at a
+        physical bound leave it up to their one-sided limits (``bound_reach``: the union of
+        the intervals conditional on any such value); for an estimate at a bound the
+        one-sided interval from the bound (:meth:`one_sided_limit`), up to the other bound
+        when the data do not determine it."""
         i = self._index(name)
+        e = self.problem.estimated[i]
         if not self.free[i]:
-            e = self.problem.estimated[i]
             limit = self.one_sided_limit(name, level)
             if self.at_bound[i] == "lower":
-                return float(e.lower), (float(e.upper) if limit is None else limit)
-            return (float(e.lower) if limit is None else limit), float(e.upper)
-        q = student.ppf(0.5 + level / 2, self.dof)
-        return float(self.values[i] - q * self.stderr[i]), float(self.values[i] + q * self.stderr[i])
+                return float(e.lower), (float(e.upper) if limit is None else min(limit, e.upper))
+            return (float(e.lower) if limit is None else max(limit, e.lower)), float(e.upper)
+        reach = (0.0, 0.0) if self.bound_reach is None else self.bound_reach[i]
+        lo, hi = self._widened(self.values[i], self.stderr[i], reach, level)
+        return max(lo, float(e.lower)), min(hi, float(e.upper))
+
+    def derived_interval(self, name: str, level: float = 0.95) -> tuple[float, float]:
+        """The ``level`` (default 0.95) interval of the derived quantity ``name``
+        (``derived``; delta method conditional on the estimates held at bounds, reaching off
+        them as :meth:`interval`)."""
+        if name not in self.derived:
+            raise InputError(f"{name!r} is not a derived quantity of this fit; derived: "
+                             f"{', '.join(self.derived) or 'none'}")
+        v, se = self.derived[name]
+        se, *reach = self.derived_reach.get(name, (se, 0.0, 0.0))
+        return self._widened(v, se, reach, level)
+
+    def _widened(self, value: float, se: float, reach, level: float) -> tuple[float, float]:
+        """``value +/- t se``, widened by the one-sided quantile times ``reach`` (down, up)."""
+        from scipy.stats import t as student
+
+        q = float(student.ppf(0.5 + level / 2, self.dof))
+        q1 = float(student.ppf(level, self.dof))
+        return (float(value - q * se - q1 * reach[0]), float(value + q * se + q1 * reach[1]))
 
     def one_sided_limit(self, name: str, level: float = 0.95) -> float | None:
         """For an estimate ``name`` at a bound: the one-sided ``level`` confidence limit away
@@ -61,9 +81,14 @@ class ResultIntervals:
         return float(e.lower + q * se) if side == "lower" else float(e.upper - q * se)
 
     def uncertainty_text(self, i: int) -> str:
-        """``+/- se`` of estimate ``i``, or what stands for it at a bound."""
+        """``+/- se`` of estimate ``i`` (with its 95 % interval when an estimate held at a
+        bound widens it), or what stands for it at a bound."""
         if self.free[i]:
-            return f"+/- {self.stderr[i]:.3g}"
+            text = f"+/- {self.stderr[i]:.3g}"
+            if self.bound_reach is not None and np.any(self.bound_reach[i]):
+                lo, hi = self.interval(self.names[i])
+                text += f" (95 %: [{lo:.6g}, {hi:.6g}] off the held bounds)"
+            return text
         e = self.problem.estimated[i]
         side = self.at_bound[i]
         limit = self.one_sided_limit(self.names[i])
@@ -154,4 +179,21 @@ class ResultIntervals:
                 text += ("Here the Gauss-Newton standard errors are optimistic: the robust ones "
                          "are " + ", ".join(f"{r:.2g}x for `{n}`" for n, r in worse.items())
                          + ". ")
-        return text + _PROFILE_HINT
+        return text + self._reach_note() + _PROFILE_HINT
+
+    def _reach_note(self) -> str:
+        """What the intervals add for the estimates held at physical bounds, or ''."""
+        if self.bound_reach is None or not np.any(self.bound_reach):
+            return ""
+        from scipy.stats import t as student
+
+        q1 = float(student.ppf(0.95, self.dof))
+        held = [n for n, side, f in zip(self.names, self.at_bound, self.free) if side and not f]
+        moved = [f"`{n}` {-q1 * d:+.3g}/{q1 * u:+.3g}"
+                 for n, (d, u), f in zip(self.names, self.bound_reach, self.free)
+                 if f and (d or u)]
+        return ("Held at a physical bound: " + ", ".join(f"`{n}`" for n in held) + ". The "
+                "truth may lie just inside it, so the 95 % intervals of the estimates that "
+                "move with it reach as far as they move when it leaves the bound up to its "
+                "one-sided 95 % limit (the union of the intervals conditional on any such "
+                "value): " + ", ".join(moved) + ". ")

@@ -18,16 +18,19 @@ if TYPE_CHECKING:  # pragma: no cover
 
 from .intervals import OPTIMISTIC_FACTOR, ResultIntervals
 
-__all__ = ["FitResult", "OPTIMISTIC_FACTOR", "derived_quantities"]
+__all__ = ["FitResult", "OPTIMISTIC_FACTOR", "derived_quantities", "reach_sides"]
 
 def derived_quantities(problem: "FitProblem", theta: np.ndarray, cov: np.ndarray,
-                       free: np.ndarray | None = None
-                       ) -> tuple[dict[str, tuple[float, float]], dict[str, str]]:
+                       held: np.ndarray | None = None, reach: np.ndarray | None = None
+                       ) -> tuple[dict[str, tuple[float, float]], dict[str, str],
+                                  dict[str, tuple[float, float, float]]]:
     """The quantities the model's components derive (:meth:`analogs.Model.derived_quantities`,
     e.g. ``pN.frequency_hz`` and ``pN.damping_ratio`` with the summed hinge and diaphragm
-    terms) at the estimates of case 0, with delta-method standard errors; and their units.
-    A quantity that depends on an estimate at a bound (``free`` False) has no standard
-    error (NaN)."""
+    terms) at the estimates of case 0, with delta-method standard errors; their units; and,
+    for the intervals, ``(standard error, down, up)``: the standard error conditional on the
+    estimates ``held`` at a bound (their rows of ``cov`` are zero) and the reach off those
+    bounds per unit one-sided quantile along the regression ``reach`` (:func:`reach_sides`).
+    A quantity that depends on a held estimate has no standard error (NaN)."""
     th = ca.MX.sym("theta", theta.size)
     vals: dict[str, Any] = dict(problem.fixed[0])
     for j, e in enumerate(problem.estimated):
@@ -38,16 +41,27 @@ def derived_quantities(problem: "FitProblem", theta: np.ndarray, cov: np.ndarray
         vals[t.parameter] = t.constant + sum(k * th[labels.index(n)] for n, k in t.terms)
     found = problem.model.derived_quantities(vals)
     if not found:
-        return {}, {}
+        return {}, {}, {}
     e = ca.vertcat(*[ca.MX(v) if not isinstance(v, ca.MX) else v for v, _ in found.values()])
     fn = ca.Function("derived", [th], [e, ca.jacobian(e, th)])
     v, J = fn(theta)
     v, J = np.asarray(v).ravel(), np.asarray(J)
     se = np.sqrt(np.clip(np.einsum("ij,jk,ik->i", J, cov, J), 0, None))
-    if free is not None and not np.all(free):
-        se[np.any(J[:, ~np.asarray(free, bool)] != 0, axis=1)] = np.nan
-    values = {k: (float(a), float(b)) for k, a, b in zip(found, v, se)}
-    return values, {k: unit for k, (_, unit) in found.items()}
+    shown = se.copy()
+    if held is not None and np.any(held):
+        shown[np.any(J[:, np.asarray(held, bool)] != 0, axis=1)] = np.nan
+    sides = reach_sides(J @ reach) if reach is not None else np.zeros((len(found), 2))
+    return ({k: (float(a), float(b)) for k, a, b in zip(found, v, shown)},
+            {k: unit for k, (_, unit) in found.items()},
+            {k: (float(a), float(b), float(c)) for k, a, (b, c) in zip(found, se, sides)})
+
+
+def reach_sides(reach: np.ndarray) -> np.ndarray:
+    """``(rows, 2)``: how far each row's quantity reaches down and up when every held
+    estimate (a column of ``reach``, signed away from its bound) leaves its bound by one
+    standard deviation, the held estimates moving independently (a box)."""
+    return np.stack([np.maximum(-reach, 0).sum(axis=1), np.maximum(reach, 0).sum(axis=1)],
+                    axis=1)
 
 
 @dataclass(frozen=True)
@@ -157,6 +171,17 @@ class FitResult(ResultIntervals):
     #: it away from the bound (NaN when they do not determine it), for a one-sided interval.
     at_bound: tuple[str | None, ...] = ()
     bound_stderr: np.ndarray | None = field(default=None, repr=False)
+    #: Per estimate and derived quantity, ``(down, up)``: how far its value reaches when the
+    #: estimates held at physical bounds leave them by one ``bound_stderr`` each, the others
+    #: re-estimated (the regression in the covariance without the bounds). The truth may be
+    #: just inside a bound; the intervals add this reach times the one-sided quantile
+    #: (:meth:`interval`). Zero when nothing is held or nothing correlates with it.
+    bound_reach: np.ndarray | None = field(default=None, repr=False)
+    #: Per derived quantity, ``(standard error, down, up)`` for its interval: the standard
+    #: error conditional on the held estimates (``derived`` has none for a quantity that
+    #: depends on one) and its reach as ``bound_reach``.
+    derived_reach: dict[str, tuple[float, float, float]] = field(default_factory=dict,
+                                                                 repr=False)
     #: The linear bounds the estimates end on (the masses within the liquid,
     #: :mod:`estimate.fitting.budget`), in words; the covariance holds them there.
     active_bounds: tuple[str, ...] = ()

@@ -16,7 +16,7 @@ from .assembly import NlpOutputs
 from .covariance import uncertainty
 from .noise_figures import case_figures, model_error_factor
 from .problem import FitProblem
-from .result import FitResult, derived_quantities
+from .result import FitResult, derived_quantities, reach_sides
 from .terms import CaseTerms
 from .transcription import Transcription
 
@@ -154,7 +154,13 @@ def fit_result(problem: FitProblem, solve: Solve) -> FitResult:
     cov = unc.robust if unc.robust is not None else unc.covariance
     free = np.array([side is None for side in at_bound])
     stderr = np.where(free, np.sqrt(np.clip(np.diag(cov), 0, None)), np.nan)
-    derived, derived_units = derived_quantities(problem, theta, cov, ~held)
+    # the held estimates' regression columns, signed away from their bounds
+    away = np.array([{"lower": 1.0, "upper": -1.0}.get(side, 0.0) if h else 0.0
+                     for side, h in zip(at_bound, held)])
+    reach = None if unc.bound_reach is None else \
+        unc.bound_reach * np.r_[away, np.ones(unc.bound_reach.shape[1] - away.size)][None, :]
+    bound_stderr = unc.bound_stderr
+    derived, derived_units, derived_reach = derived_quantities(problem, theta, cov, held, reach)
     pieces = np.split(raw, np.cumsum([int(np.size(m)) for m in measured])[:-1])
     residuals = tuple(p if np.ndim(m) == 1 else p.reshape(m.shape, order="F")
                       for p, m in zip(pieces, measured))
@@ -167,7 +173,13 @@ def fit_result(problem: FitProblem, solve: Solve) -> FitResult:
         if kind == "robust":
             cov = robust
             stderr = np.where(free, np.sqrt(np.clip(np.diag(cov), 0, None)), np.nan)
-            derived, derived_units = derived_quantities(problem, theta, cov, ~held)
+            # the model error widens the spread off the bounds as it widens the rest
+            if reach is not None:
+                reach = reach * widen
+            if bound_stderr is not None:
+                bound_stderr = bound_stderr * widen
+            derived, derived_units, derived_reach = derived_quantities(problem, theta, cov,
+                                                                       held, reach)
     return FitResult(
         problem=problem,
         values=theta, stderr=stderr, covariance=cov,
@@ -191,7 +203,9 @@ def fit_result(problem: FitProblem, solve: Solve) -> FitResult:
         objective=float(e @ e), residual_variance=unc.sigma2,
         dof=max(n_force + n_disp - (Je.shape[1] - Jg.shape[0]), 1),
         initial_state_kinds=solve.initial_state_kinds, initial_states=solve.initial_states,
-        at_bound=at_bound, bound_stderr=unc.bound_stderr,
+        at_bound=at_bound, bound_stderr=bound_stderr,
+        bound_reach=None if reach is None else np.where(free[:, None], reach_sides(reach), 0.0),
+        derived_reach=derived_reach,
         active_bounds=tuple(b.text for b in active), noise_figures=figures,
         gauss_newton_covariance=unc.covariance, robust_covariance=robust,
         covariance_kind=kind, bandwidths=unc.bandwidths, model_error=widen,
@@ -206,11 +220,20 @@ def _on_linear_bound(bound, problem: FitProblem, theta: np.ndarray) -> bool:
 def _held_on(unc, rows: np.ndarray):
     """``unc`` with its covariances (Gauss-Newton and robust) conditioned on the active
     linear bounds ``rows``
-    (:func:`estimate.fitting.budget.conditioned`), standard errors and correlations anew."""
+    (:func:`estimate.fitting.budget.conditioned`), standard errors and correlations anew,
+    and the reach off them appended to ``bound_reach``: the estimates' joint regression on
+    the rows' values, one standard deviation of each into the bound (the truth may be just
+    inside: a liquid not quite all in the analog)."""
 
     from .budget import conditioned
 
     free = np.isfinite(unc.stderr)
+    C = unc.covariance[np.ix_(free, free)]
+    A = rows[:, free]
+    M = A @ C @ A.T
+    inside = np.zeros((free.size, rows.shape[0]))
+    inside[free] = -(C @ A.T @ np.linalg.pinv(M)) * np.sqrt(np.clip(np.diag(M), 0, None))
+    before = np.zeros((free.size, free.size)) if unc.bound_reach is None else unc.bound_reach
 
     def held(c):
         out = np.zeros_like(c)
@@ -226,7 +249,8 @@ def _held_on(unc, rows: np.ndarray):
         sub = cov[np.ix_(free, free)] / np.outer(se[free], se[free])
     corr[np.ix_(free, free)] = np.clip(np.nan_to_num(sub, nan=0.0, posinf=0.0, neginf=0.0),
                                        -1.0, 1.0)
-    return replace(unc, covariance=cov, stderr=se, correlation=corr, robust=robust)
+    return replace(unc, covariance=cov, stderr=se, correlation=corr, robust=robust,
+                   bound_reach=np.hstack([before, inside]))
 
 
 def _at_bound(x, value: float) -> str | None:

@@ -60,12 +60,9 @@ def _noise_dict(carriage: Any, noise: Any) -> dict[str, Any] | None:
 
 
 def _derived_intervals(result: "FitResult") -> dict[str, list[float | None]]:
-    """95 % interval of each derived quantity (delta method, t quantile of the fit's degrees
-    of freedom, as the estimates'); null where there is no standard error."""
-    from scipy.stats import t as student
-
-    q = float(student.ppf(0.975, result.dof))
-    return {k: [_number(v - q * se), _number(v + q * se)] for k, (v, se) in result.derived.items()}
+    """95 % interval of each derived quantity (:meth:`FitResult.derived_interval`); null
+    where there is no standard error."""
+    return {k: [_number(x) for x in result.derived_interval(k)] for k in result.derived}
 
 
 def _parameters(result: "FitResult") -> dict[str, Any]:

@@ -100,6 +100,96 @@ def test_a_length_on_its_prediction_band_is_not_held_in_the_others_intervals(tmp
     assert 0 < se < 1e-3 * f
 
 
+def test_the_reach_off_a_bound_is_the_conditional_least_squares_shift():
+    """``bound_reach`` against numpy's least squares on a linear model y = a u + b v + c w
+    with b and c held at their bound 0: column b is how far a's least-squares estimate moves
+    when b is fixed one of its unconditional standard deviations off 0 (c still at 0), and
+    its own row that standard deviation (sigma^2 (A^T A)^-1). Scaled parameters, to check
+    the units. Tolerance 1e-9 relative: both are exact linear algebra."""
+    import scipy.sparse as sps
+
+    from estimate.fitting.covariance import uncertainty
+
+    rng = np.random.default_rng(3)
+    n = 200
+    A = rng.normal(size=(n, 3))
+    A[:, 1] += 0.8 * A[:, 0]  # correlated columns: a moves with b
+    A[:, 2] += 0.3 * A[:, 0] - 0.5 * A[:, 1]
+    scales = np.array([2.0, 0.01, 5.0])
+    y = A @ np.array([1.0, 0.3, 0.1]) + 0.5 * rng.normal(size=n)
+    a0 = np.linalg.lstsq(A[:, :1], y, rcond=None)[0][0]  # b, c held at 0
+    r = A[:, 0] * a0 - y
+    unc = uncertainty(sps.csc_matrix(A * scales), sps.csc_matrix((0, 3)), r, n, 3, scales,
+                      ("a", "b", "c"), held=(1, 2))
+    sigma2 = r @ r / (n - 3)
+    full = sigma2 * np.linalg.inv(A.T @ A)
+    for h in (1, 2):
+        sd = np.sqrt(full[h, h])
+        assert unc.bound_stderr[h] == pytest.approx(sd, rel=1e-9)
+        a_moved = np.linalg.lstsq(A[:, :1], y - A[:, h] * sd, rcond=None)[0][0]
+        assert unc.bound_reach[0, h] == pytest.approx(a_moved - a0, rel=1e-9)
+        assert unc.bound_reach[h, h] == pytest.approx(sd, rel=1e-9)
+        assert unc.bound_reach[3 - h, h] == pytest.approx(0.0, abs=1e-12)  # the other stays
+
+
+def test_the_reach_off_a_linear_bound_is_the_constrained_least_squares_shift():
+    """The liquid budget ``a . theta <= u`` held active: the reach appended to
+    ``bound_reach`` is how far the equality-constrained least-squares estimate moves when
+    ``u`` is lowered by the unconstrained standard deviation of ``a . theta`` (a KKT solve
+    with numpy at both values as the reference; 1e-9 relative, exact linear algebra)."""
+    from dataclasses import replace
+
+    import scipy.sparse as sps
+
+    from estimate.fitting.covariance import uncertainty
+    from estimate.fitting.solution import _held_on
+
+    rng = np.random.default_rng(5)
+    n = 150
+    A = rng.normal(size=(n, 3))
+    A[:, 1] += 0.6 * A[:, 0]
+    y = A @ np.array([1.0, 0.5, -0.2]) + 0.3 * rng.normal(size=n)
+    a = np.array([1.0, 1.0, 0.0])  # e.g. fixed + pendulum mass <= liquid
+
+    def constrained(u):
+        K = np.block([[A.T @ A, a[:, None]], [a[None, :], np.zeros((1, 1))]])
+        return np.linalg.solve(K, np.r_[A.T @ y, u])[:3]
+
+    u = 1.2
+    theta = constrained(u)
+    r = A @ theta - y
+    unc = uncertainty(sps.csc_matrix(A), sps.csc_matrix((0, 3)), r, n, 3, np.ones(3),
+                      ("a", "b", "c"))
+    sd = float(np.sqrt(a @ unc.covariance @ a))
+    held = _held_on(replace(unc, bound_reach=None), a[None, :])
+    assert held.bound_reach.shape == (3, 4)  # a column per estimate, then the bound's
+    np.testing.assert_allclose(held.bound_reach[:, 3], constrained(u - sd) - theta, rtol=1e-9)
+    assert abs(a @ held.covariance @ a) < 1e-12  # held on the bound
+
+
+def test_a_spring_held_at_zero_does_not_pin_the_length_of_a_true_spring(tmp_path):
+    """A true hinge spring of 0.1 N m/rad, driven lightly near resonance (20 s, 100 Hz,
+    0.2 mm): the lateral force fixes the frequency, g/L + k/(m L^2), not the length and the
+    spring apart, and in this record the spring ends on its bound 0 and is held there. The
+    length then takes up the spring's share of the frequency: 0.04826 m against 0.0553, and
+    its interval conditional on k = 0 was +/- 0.00019 m (38 half-widths from the truth).
+    With the reach off the bound the length's interval holds the truth, and the frequency,
+    which the data do fix, keeps an interval within 0.5 % of itself that holds its true
+    value."""
+    p = pendulum(stiffness=0.1)
+    case, _ = make_case(tmp_path, "E", ref.Ramped(ref.Sine(0.0002, 2.0), 1.0, 0.0),
+                        pendulums=[p], duration=20.0, rate=100.0, seed=2)
+    res = fit(FitProblem.build(case, model_from_spec("fixed,p1", case)), progress=False)
+    assert res.converged
+    assert res.at_bound[res.names.index("p1.stiffness")] == "lower"  # the case of this test
+    lo, hi = res.interval("p1.length")
+    assert lo <= p.length <= hi
+    f_true = np.sqrt(9.80665 / p.length + p.stiffness / (p.mass * p.length**2)) / (2 * np.pi)
+    lo, hi = res.derived_interval("p1.frequency_hz")
+    assert lo <= f_true <= hi and hi - lo < 5e-3 * f_true
+    assert "p1.length" in res.report() and "off the held bounds" in res.report()
+
+
 def test_heights_missing_from_the_prediction_come_from_the_tank_analysis(
         spinning_case_with_prediction):
     case = spinning_case_with_prediction
