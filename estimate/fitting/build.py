@@ -207,6 +207,8 @@ class Start:
     tied: set[str]
     given: set[str]
     stage_start: dict[str, float]
+    #: The starts the first stage replaced, as they were (the prediction's).
+    before_stage: dict[str, float]
 
 
 def starting_point(args: Arguments, model: Model, exps: Sequence[Experiment], params: Mapping,
@@ -229,7 +231,7 @@ def starting_point(args: Arguments, model: Model, exps: Sequence[Experiment], pa
         start["rig.dry_mass"] = container_guess(cases[0])
         sources = {**sources, "rig.dry_mass": "a guess (the liquid mass)"}
     given = set(args.initial) | set(hold) | set(explicit)
-    stage_start = {}
+    stage_start, before_stage = {}, {}
     if stage is not None:
         from .first_stage import starting_values
 
@@ -237,6 +239,7 @@ def starting_point(args: Arguments, model: Model, exps: Sequence[Experiment], pa
             stage, gravity=cases[0].rig.gravity, estimated=names,
             values={**start, **exps[0].fixed},
             liquid_mass=liquid_or_none(cases[0])).items() if k not in given}
+        before_stage = {k: start[k] for k in stage_start if k in start}
         start |= stage_start
         sources = {**sources, **dict.fromkeys(stage_start, "the first stage")}
         notes.append(stage.describe())
@@ -250,7 +253,7 @@ def starting_point(args: Arguments, model: Model, exps: Sequence[Experiment], pa
             f"no initial value for {', '.join(f'`{n}`' for n in missing)}: {why}; give them "
             f"with `initial` (e.g. `FitProblem.build(..., initial={{'{missing[0]}': ...}})`)")
     notes += source_notes(sources, [n for n in names if n not in given])
-    return Start(names, start, predicted, ties, linear, tied, given, stage_start)
+    return Start(names, start, predicted, ties, linear, tied, given, stage_start, before_stage)
 
 
 def estimates(names: Sequence[str], params: Mapping, args: Arguments, start: Mapping[str, float],
@@ -360,7 +363,9 @@ def build_problem(cls, cases: Case | Sequence[Case], model: Model, *,
         fixed.append(vals)
     notes += noise_notes(exps, carriage, noise)
     return cls(model, exps, tuple(est), tuple(fixed), tuple(notes), w, tuple(measurement),
-               args.channel_weights, args.mode, carriage, noise, ties, linear, stage, inside)
+               args.channel_weights, args.mode, carriage, noise, ties, linear, stage, inside,
+               prediction_start={e.name: st.before_stage[e.parameter] for e in est
+                                 if e.parameter in st.before_stage})
 
 
 def _resolve_channels(measurement: tuple, exps: Sequence[Experiment]) -> tuple:

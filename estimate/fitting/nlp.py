@@ -16,7 +16,7 @@ from __future__ import annotations
 import sys
 import time
 from collections.abc import Mapping
-from dataclasses import dataclass
+from dataclasses import dataclass, replace
 
 import casadi as ca
 import numpy as np
@@ -33,6 +33,7 @@ from .problem import FitProblem
 from .refits import refined
 from .result import FitResult
 from .solution import LOW_R_SQUARED, Solve, fit_result
+from .starts import second_start
 from .strategies import Cost, cost_of
 from .transcription import MultipleShooting, Transcription
 
@@ -162,11 +163,33 @@ def fit(problem: FitProblem, *, transcription: Transcription = MultipleShooting(
             problem = problem.with_initial(start)
     result = _solve(problem, transcription, hessian, cost, kinds, solver_options, progress,
                     compile_, warm_start, t_start)
+    other = second_start(problem) if _free_retry and warm_start is None else None
+    if other is not None:
+        problem, result = _better_start(problem, result, *other, lambda p: _solve(
+            p, transcription, hessian, cost, kinds, solver_options, progress, compile_, None,
+            t_start))
     return refined(problem, result, transcription=transcription, hessian=hessian, cost=cost,
                    initial_state=initial_state, solver_options=solver_options,
                    progress=progress, compile_=compile_, warm_start=warm_start,
                    balance=balance, free_retry=_free_retry,
                    unbounded_retry=unbounded_retry, t_start=t_start)
+
+
+def _better_start(problem: FitProblem, result: FitResult, other: FitProblem, why: str,
+                  solve) -> tuple[FitProblem, FitResult]:
+    """The problem and solve, of ``problem`` (solved: ``result``) and ``other`` (the same
+    from the prediction, solved by ``solve``), that converged to the lower objective, with
+    a note saying both were tried."""
+    second = solve(other)
+    keep = second.converged and (not result.converged or second.objective < result.objective)
+    kept, dropped = (second, result) if keep else (result, second)
+    note = (f"the first stage's masses lay far from the prediction ({why}): the fit was "
+            f"solved from both; kept the {'prediction' if keep else 'first stage'}'s "
+            f"(objective {kept.objective:.6g}; the other {dropped.objective:.6g}"
+            f"{'' if dropped.converged else ', not converged'})")
+    p, r = (other, second) if keep else (problem, result)
+    p = replace(p, notes=p.notes + (note,))
+    return p, replace(r, problem=p, iterations=result.iterations + second.iterations)
 
 
 #: A carriage spline whose knots are more than this many samples apart somewhere (0.25 s at

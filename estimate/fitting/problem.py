@@ -99,6 +99,9 @@ class FitProblem:
     #: (:func:`~estimate.fitting.budget.tank_ranges`), by parameter name: checked after the
     #: fit (:attr:`FitResult.outside_tank`), not bounds of the NLP.
     tank_ranges: Mapping[str, tuple[float, float]] = field(default_factory=dict)
+    #: The starts the first stage replaced, as the prediction gave them (by label): a second
+    #: start when the first stage's masses are far from them (:func:`~estimate.fitting.nlp.fit`).
+    prediction_start: Mapping[str, float] = field(default_factory=dict, repr=False)
 
     @classmethod
     def build(cls, cases: Case | Sequence[Case], model: Model, *,
