@@ -163,7 +163,8 @@ def fit(problem: FitProblem, *, transcription: Transcription = MultipleShooting(
             problem = problem.with_initial(start)
     result = _solve(problem, transcription, hessian, cost, kinds, solver_options, progress,
                     compile_, warm_start, t_start)
-    other = second_start(problem) if _free_retry and warm_start is None else None
+    other = (second_start(problem, dict(zip(result.names, result.values)))
+             if _free_retry and warm_start is None else None)
     if other is not None:
         problem, result = _better_start(problem, result, *other, lambda p: _solve(
             p, transcription, hessian, cost, kinds, solver_options, progress, compile_, None,
@@ -183,8 +184,8 @@ def _better_start(problem: FitProblem, result: FitResult, other: FitProblem, why
     second = solve(other)
     keep = second.converged and (not result.converged or second.objective < result.objective)
     kept, dropped = (second, result) if keep else (result, second)
-    note = (f"the first stage's masses lay far from the prediction ({why}): the fit was "
-            f"solved from both; kept the {'prediction' if keep else 'first stage'}'s "
+    note = (f"the fit from the first stage ended with masses far from the prediction ({why}):"
+            f" solved from the prediction too; kept the {'prediction' if keep else 'first stage'}'s "
             f"(objective {kept.objective:.6g}; the other {dropped.objective:.6g}"
             f"{'' if dropped.converged else ', not converged'})")
     p, r = (other, second) if keep else (problem, result)

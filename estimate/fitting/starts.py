@@ -28,16 +28,17 @@ LAG_MIN = 0.002
 LAG_MODES = ("auto", "estimate", "none")
 
 
-#: The first stage's mass starts are checked against the prediction's: when one differs by
-#: more than this fraction of the liquid mass, the fit is solved from the prediction too
-#: and the lower objective kept (:func:`second_start`).
+#: A fit the first stage started whose masses end farther than this fraction of the liquid
+#: mass from the prediction is solved from the prediction too, and the lower objective kept
+#: (:func:`second_start`).
 SECOND_START_SPREAD = 0.25
 
 
-def second_start(problem) -> tuple[object, str] | None:
-    """``problem`` started from the prediction where the first stage's mass starts lie far
-    from it (more than :data:`SECOND_START_SPREAD` of the liquid mass, or of the predicted
-    masses' sum when the tank gives none), with the reason in words; ``None`` otherwise.
+def second_start(problem, values) -> tuple[object, str] | None:
+    """``problem`` started from the prediction where the first stage started its masses and
+    the fit's ``values`` (by label) left them far from it (more than
+    :data:`SECOND_START_SPREAD` of the liquid mass, or of the predicted masses' sum when the
+    tank gives none), with the reason in words; ``None`` otherwise.
 
     A record that barely separates the rigid from the sloshing mass (a light sine near
     resonance: its steady state fixes only their sum weighted by the resonance) can lead
@@ -52,15 +53,15 @@ def second_start(problem) -> tuple[object, str] | None:
         return None
     liquid = liquid_or_none(problem.experiments[0].case)
     total = liquid if liquid else sum(abs(pred[e.name]) for e in masses)
-    far = [e for e in masses if abs(e.initial - pred[e.name]) > SECOND_START_SPREAD * total]
+    far = [e for e in masses if abs(values[e.name] - pred[e.name]) > SECOND_START_SPREAD * total]
     if not far:
         return None
     other = problem.with_initial(pred)
-    values = {e.name: e.initial for e in other.estimated}
-    if any(b.slack(other.names, np.array(list(values.values()))) < 0
-           for b in other.linear_bounds) or any(t.value(values) < 0 for t in other.ties):
+    start = {e.name: e.initial for e in other.estimated}
+    if any(b.slack(other.names, np.array(list(start.values()))) < 0
+           for b in other.linear_bounds) or any(t.value(start) < 0 for t in other.ties):
         return None  # the prediction puts more mass in the analog than the liquid holds
-    why = ", ".join(f"`{e.name}` {e.initial:.4g} against {pred[e.name]:.4g} {e.unit}"
+    why = ", ".join(f"`{e.name}` {values[e.name]:.4g} against {pred[e.name]:.4g} {e.unit}"
                     for e in far)
     return other, why
 
