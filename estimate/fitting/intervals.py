@@ -189,7 +189,8 @@ class ResultIntervals:
 
         q1 = float(student.ppf(0.95, self.dof))
         held = [n for n, side, f in zip(self.names, self.at_bound, self.free) if side and not f]
-        moved = [f"`{n}` {-q1 * d:+.3g}/{q1 * u:+.3g}"
+        moved = [f"`{n}` " + "/".join(t for t in (f"-{q1 * d:.3g}" if d else "",
+                                                    f"+{q1 * u:.3g}" if u else "") if t)
                  for n, (d, u), f in zip(self.names, self.bound_reach, self.free)
                  if f and (d or u)]
         return ("Held at a physical bound: " + ", ".join(f"`{n}`" for n in held) + ". The "

@@ -115,3 +115,35 @@ def test_robust_intervals_cover_the_first_mode_when_a_second_is_missing(tmp_path
     print(f"\nrobust {robust}, flagged optimistic {flagged}")  # the counts, with -s
     assert all(h >= 85 for h in robust.values()), robust
     assert flagged >= 85, flagged
+
+
+@pytest.mark.slow
+def test_intervals_cover_a_weak_spring_the_fit_may_hold_at_zero(tmp_path):
+    """A true hinge spring of 0.1 N m/rad (an elastomeric diaphragm's share) driven by a
+    light sine near resonance (20 s, 100 Hz, 0.2 mm at 2.0 Hz; f1 2.26 Hz) with force noise
+    and a motor tone, 40 draws. The lateral force fixes the frequency, not the length and
+    the spring apart, so in about a third of the draws the spring ends on 0 and is held
+    there; the intervals then reach off that bound. The masses', the length's and the
+    frequency's 95 % intervals cover the truth at least 34 times of 40 (a 95 % interval
+    falls below 34 with probability 0.3 %). Measured: 38, 35, 40 and 38; without the reach
+    the length's covered 28 (the 12 draws with the spring held at 0 all missed), and in one
+    draw the fixed mass, on the liquid budget as well, missed by 7 standard errors."""
+    p = pendulum(stiffness=0.1)
+    f1 = float(np.sqrt(9.80665 / p.length + p.stiffness / (p.mass * p.length**2)) / (2 * np.pi))
+    truth = {"fixed.mass": 1.456, "p1.mass": p.mass, "p1.length": p.length}
+    hits = dict.fromkeys([*truth, "p1.frequency_hz"], 0)
+    held = 0
+    n = 40
+    for seed in range(n):
+        case, _ = make_case(tmp_path, f"K{seed}", ref.Ramped(ref.Sine(0.0002, 2.0), 1.0, 0.0),
+                            pendulums=[p], duration=20.0, rate=100.0, seed=seed,
+                            tone=ref.Tone(0.05, 25.0))
+        res = fit(FitProblem.build(case, model_from_spec("fixed,p1", case)), progress=False)
+        held += res.at_bound[res.names.index("p1.stiffness")] == "lower"
+        for k, v in truth.items():
+            lo, hi = res.interval(k)
+            hits[k] += lo <= v <= hi
+        lo, hi = res.derived_interval("p1.frequency_hz")
+        hits["p1.frequency_hz"] += lo <= f1 <= hi
+    assert held >= 5, held  # the case this test is about
+    assert all(h >= 34 for h in hits.values()), hits
