@@ -137,7 +137,8 @@ def fit_result(problem: FitProblem, solve: Solve) -> FitResult:
         elif side:
             warnings.append(f"`{x.name}` = {v:.6g} {x.unit} is at its bound "
                             f"[{x.lower:.6g}, {x.upper:.6g}]: no standard error, held there in "
-                            "the covariance")
+                            "the covariance; the intervals of the estimates that move with it "
+                            "reach off the bound")
     F_all = np.concatenate([t.scaled_measured[np.tile(t.weights, c) > 0]
                             for t, c in zip(terms, nch)])
     ssr = float(report @ report)
