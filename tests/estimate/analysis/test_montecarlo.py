@@ -166,6 +166,27 @@ def test_cli_montecarlo_local(tmp_path, capsys):
                  "--local", "--out", str(out)]) == 2  # exists, no --overwrite
 
 
+def test_cli_montecarlo_says_the_draws_hold_an_estimate_at_its_bound(tmp_path, capsys):
+    """A fit record whose spring was estimated and ended on 0 (written as `slosh fit` does:
+    estimated, at_bound, no covariance): the draws cannot move it, and the command says so
+    beside the intervals that do; a record without one gets no such warning."""
+    from pathlib import Path
+
+    from estimate.cli import main
+
+    examples = Path(__file__).resolve().parents[3] / "examples"
+    fit = fit_json(tmp_path / "fit.json")
+    run = ["montecarlo", str(fit), str(examples / "A1.toml"), "--samples", "4", "--local"]
+    assert main([*run, "--out", str(tmp_path / "a")]) == 0
+    assert "ended on a bound" not in capsys.readouterr().err
+    data = json.loads(fit.read_text())
+    data["parameters"]["p1.stiffness"] |= {"estimated": True, "at_bound": "lower"}
+    fit.write_text(json.dumps(data))
+    assert main([*run, "--out", str(tmp_path / "b")]) == 0
+    err = capsys.readouterr().err
+    assert "`p1.stiffness` ended on a bound" in err and "narrower" in err
+
+
 def test_cli_export_c_and_fmu(tmp_path, capsys):
     from derive.export_c import has_c_compiler
     from estimate.cli import main
