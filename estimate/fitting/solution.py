@@ -148,20 +148,6 @@ def fit_result(problem: FitProblem, solve: Solve) -> FitResult:
                         f"{r_squared:.3g}): the record may hold noise only, a channel of "
                         "another quantity, or a drive that does not excite the model; check it "
                         "before using these estimates")
-    # the intervals use the robust covariance: the Gauss-Newton one when the residuals are
-    # white, wider when they are correlated (coloured noise, a filtered force, a model that
-    # misses a small effect), where the Gauss-Newton one is optimistic
-    kind = "robust" if unc.robust is not None else "gauss-newton"
-    cov = unc.robust if unc.robust is not None else unc.covariance
-    free = np.array([side is None for side in at_bound])
-    stderr = np.where(free, np.sqrt(np.clip(np.diag(cov), 0, None)), np.nan)
-    # the held estimates' regression columns, signed away from their bounds
-    away = np.array([{"lower": 1.0, "upper": -1.0}.get(side, 0.0) if h else 0.0
-                     for side, h in zip(at_bound, held)])
-    reach = None if unc.bound_reach is None else \
-        unc.bound_reach * np.r_[away, np.ones(unc.bound_reach.shape[1] - away.size)][None, :]
-    bound_stderr = unc.bound_stderr
-    derived, derived_units, derived_reach = derived_quantities(problem, theta, cov, held, reach)
     pieces = np.split(raw, np.cumsum([int(np.size(m)) for m in measured])[:-1])
     residuals = tuple(p if np.ndim(m) == 1 else p.reshape(m.shape, order="F")
                       for p, m in zip(pieces, measured))
@@ -171,16 +157,21 @@ def fit_result(problem: FitProblem, solve: Solve) -> FitResult:
     if robust is not None:
         widen = model_error_factor(figures, residuals, tuple(weights))
         robust = robust * widen**2
-        if kind == "robust":
-            cov = robust
-            stderr = np.where(free, np.sqrt(np.clip(np.diag(cov), 0, None)), np.nan)
-            # the model error widens the spread off the bounds as it widens the rest
-            if reach is not None:
-                reach = reach * widen
-            if bound_stderr is not None:
-                bound_stderr = bound_stderr * widen
-            derived, derived_units, derived_reach = derived_quantities(problem, theta, cov,
-                                                                       held, reach)
+    # the intervals use the robust covariance: the Gauss-Newton one when the residuals are
+    # white, wider when they are correlated (coloured noise, a filtered force, a model that
+    # misses a small effect), where the Gauss-Newton one is optimistic
+    kind = "robust" if robust is not None else "gauss-newton"
+    cov = robust if robust is not None else unc.covariance
+    free = np.array([side is None for side in at_bound])
+    stderr = np.where(free, np.sqrt(np.clip(np.diag(cov), 0, None)), np.nan)
+    # the held estimates' regression columns, signed away from their bounds; the model error
+    # widens the spread off the bounds as it widens the rest
+    away = np.array([{"lower": 1.0, "upper": -1.0}.get(side, 0.0) if h else 0.0
+                     for side, h in zip(at_bound, held)])
+    reach = None if unc.bound_reach is None else widen * unc.bound_reach * np.r_[
+        away, np.ones(unc.bound_reach.shape[1] - away.size)][None, :]
+    bound_stderr = None if unc.bound_stderr is None else widen * unc.bound_stderr
+    derived, derived_units, derived_reach = derived_quantities(problem, theta, cov, held, reach)
     return FitResult(
         problem=problem,
         values=theta, stderr=stderr, covariance=cov,
