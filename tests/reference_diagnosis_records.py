@@ -191,9 +191,14 @@ RECORDS: dict[str, Record] = {
                                   ("rig_friction",), {"rig.friction_viscous": 1.0}, fill=0.8,
                                   fixed_mass=FIXED80 + 0.066, seed=123, displacement_noise=1e-5,
                                   effects={"tone": TONE, "friction": ref.Friction(0.05, 1.0)},
-                                  known="named sensor_delay + slosh_mode (1.56 x the noise): the "
-                                        "Coulomb part's square wave in a 0.3 mm chirp reads as a "
-                                        "phase lag; rig_friction screened with a negative sign"),
+                                  known="names rig_friction and explains the data (1.14 x the "
+                                        "noise), but with the viscous part at 0 (interval "
+                                        "[0, 0.40] N s/m) and the Coulomb part at 0.0567 N "
+                                        "(+13 %): under a 0.3 mm chirp (carriage velocity "
+                                        "< 7.5 mm/s) the viscous force is under the noise, and "
+                                        "the fitted Coulomb term's tanh, smoothed over 1 mm/s, "
+                                        "takes it up; a sharper tanh (0.1 mm/s) does not "
+                                        "converge"),
     "steps60_asymmetric": Record("asymmetric hinge spring 0.13 th^2", STEPS60,
                                  (ref.Pendulum(P60.mass, P60.length, 0.0, P60.damping,
                                                extra=lambda th, thd: 0.13 * th**2),),

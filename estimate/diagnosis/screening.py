@@ -14,7 +14,8 @@ is the current model's.
 
 from __future__ import annotations
 
-from collections.abc import Callable, Sequence
+import itertools
+from collections.abc import Callable, Mapping, Sequence
 
 from analogs import HingeTorqueTerms, Model
 
@@ -59,9 +60,43 @@ def screen(current: FitResult, terms: Sequence[Term], *,
     out = []
     for t in terms:
         reduction, values = lin.score(base + t.parameters)
-        new = {n: values[n] for n in t.parameters}
-        wrong = [n for n, sign in t.signs.items() if sign * new[n] <= 0]
-        why = (f"the step points to {', '.join(f'`{n}` = {new[n]:.3g}' for n in wrong)}, "
-               "which is not physical") if wrong else None
-        out.append(Score(t, reduction / s2, len(t.parameters), values, why))
+        wrong = _unphysical(t, values)
+        held: tuple[str, ...] = ()
+        if wrong:
+            reduction, values, held = _physical_step(lin, base, t, reduction, values)
+        why = (f"the step points to {', '.join(f'`{n}` = {values[n]:.3g}' for n in wrong)}, "
+               "which is not physical") if wrong and not held else None
+        out.append(Score(t, reduction / s2, len(t.parameters), values, why, held))
     return lin, base, sorted(out, key=lambda sc: -sc.statistic)
+
+
+def _unphysical(term: Term, values: Mapping[str, float], held: tuple[str, ...] = ()) -> list[str]:
+    """The term's parameters of a physical sign (but those ``held``) that ``values`` gives
+    the other sign (or 0)."""
+    return [n for n, sign in term.signs.items() if n not in held and sign * values[n] <= 0]
+
+
+def _physical_step(lin: Linearisation, base: tuple[str, ...], term: Term, reduction: float,
+                   values: dict[str, float]) -> tuple[float, dict[str, float], tuple[str, ...]]:
+    """The best Gauss-Newton step with the term's signed parameters of their physical sign
+    (the score's quadratic model maximised over the sign constraints): on every face
+    where some of them stay at their null values, the step in the others; the feasible one
+    that reduces the objective most. ``(reduction, values, held)``; ``held`` empty (and the
+    unconstrained step returned) when no face with a free new parameter is feasible.
+
+    Two parameters that the record barely tells apart (a viscous and a Coulomb rig
+    friction under a small carriage velocity) can make the free step put one of them at
+    the unphysical sign while the other, alone, explains most of the effect."""
+    signed = [n for n in term.parameters if term.signs.get(n, 0)]
+    best: tuple[float, dict[str, float], tuple[str, ...]] | None = None
+    for k in range(1, len(signed) + 1):
+        for held in itertools.combinations(signed, k):
+            free = tuple(n for n in term.parameters if n not in held)
+            if not free:
+                continue
+            r, v = lin.score(base + free)
+            v = {**v, **{n: float(lin.values[lin.names.index(n)]) for n in held}}
+            if not _unphysical(term, v, held) and (
+                    best is None or r > best[0]):
+                best = (r, v, held)
+    return best if best is not None else (reduction, values, ())

@@ -46,16 +46,22 @@ class Term:
 class Score:
     """A screened term: the objective reduction one Gauss-Newton step predicts over the
     residual variance (``statistic``), its degrees of freedom, the parameter values the
-    step points to, and why they are not physical (``None`` when they are)."""
+    step points to, and why they are not physical (``None`` when they are). When the
+    free step points to an unphysical sign, the statistic and values are those of the best
+    step of the physical signs, with the parameters ``held`` at their null values
+    (:func:`~estimate.diagnosis.screening.screen`)."""
 
     term: Term
     statistic: float
     dof: int
     values: Mapping[str, float]
     unphysical: str | None
+    held: tuple[str, ...] = ()
 
     def text(self) -> str:
-        return f"score {self.statistic:.0f} (chi-square, {self.dof} dof)"
+        held = (f", with {', '.join(f'`{n}`' for n in self.held)} at 0: the free step "
+                "gives it the unphysical sign" if self.held else "")
+        return f"score {self.statistic:.0f} (chi-square, {self.dof} dof{held})"
 
 
 def _no_objection(result: FitResult) -> str | None:
@@ -232,8 +238,9 @@ def trend_text(evidence: Evidence, quantity: str) -> str:
 def screened_proposal(family: Family, score: Score, ctx: Context,
                       cold_start: Mapping[str, float] | None = None) -> Proposal:
     """The fit of a screened term, started at the current estimates and at the values the
-    score step points to; plausible when every new parameter is distinct from zero (3
-    standard errors) and of its physical sign."""
+    score step points to; plausible when its new parameters are of their physical signs
+    and one at least is distinct from zero (3 standard errors: a rig friction whose
+    viscous part a slow carriage does not resolve is still a Coulomb rig friction)."""
     term = score.term
     model = ctx.model
     for c in term.components:
@@ -247,10 +254,12 @@ def screened_proposal(family: Family, score: Score, ctx: Context,
 
     def plausible(r: FitResult) -> str | None:
         for n in term.parameters:
-            if not distinct(r, n):
-                return f"`{n}` = {r.value(n):.3g} is not distinguishable from zero"
             if term.signs.get(n, 0) * r.value(n) < 0:
                 return f"`{n}` = {r.value(n):.3g} has the unphysical sign"
+        if not any(distinct(r, n) for n in term.parameters):
+            return " and ".join(f"`{n}` = {r.value(n):.3g}" for n in term.parameters) + (
+                " is not distinguishable from zero" if len(term.parameters) == 1
+                else " are not distinguishable from zero")
         return None
 
     evidence = ctx.evidence

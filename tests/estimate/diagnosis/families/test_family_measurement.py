@@ -45,3 +45,20 @@ def test_measurement_family_is_screened_and_recovers_its_effect(cause, tmp_path)
 def test_measurement_family_is_not_proposed_on_a_clean_record(cause, clean_sweep):
     run = run_family(clean_sweep, cause, fit=False)
     assert not run.proposed, [(s.term.label, s.statistic, s.unphysical) for s in run.scores]
+
+
+def test_an_offset_without_drift_is_a_plausible_sensor_offset(tmp_path):
+    """A transducer offset that does not drift: the family's fit holds a drift not distinct
+    from zero, and is still plausible (one of its parts at least is distinct), with the
+    offset within 3 standard errors of the truth."""
+    case, _ = R.write(R.short("offset_only", R.SHORT_SWEEP, seed=73, offset=0.3), tmp_path,
+                      "offset_only")
+    run = run_family(case, "sensor_offset")
+    assert run.proposed, [(s.term.label, s.statistic, s.unphysical) for s in run.scores]
+    fit = run.fit
+    assert fit.converged, fit.status
+    drift_se = fit.stderr[fit.names.index("rig.force_drift")]
+    assert abs(fit.value("rig.force_drift")) < 3 * drift_se  # the drift is not resolved
+    assert run.proposals[0].plausible(fit) is None
+    se = fit.stderr[fit.names.index("rig.force_offset")]
+    assert abs(fit.value("rig.force_offset") - 0.3) <= SE * se
