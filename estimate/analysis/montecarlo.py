@@ -2,7 +2,12 @@
 
 Parameters are drawn from the fit's covariance (a multivariate normal truncated to the
 parameter bounds by rejection: draws outside the bounds are redrawn, never clipped), all in
-this process from one seed; the draws are simulated in fixed-size batches (one CasADi
+this process from one seed. An estimate the fit holds on a physical bound (a hinge spring
+at 0, the masses on the liquid budget) leaves it by a half-normal amount of its one-sided
+standard deviation, the other estimates moving with it along the fit's regression
+(``covariance.off_bounds``): the posterior of a flat prior on the physical side when the
+data put the estimate on the bound, so the draws spread as far off the bound as the fit's
+intervals reach; the draws are simulated in fixed-size batches (one CasADi
 function mapped over the batch, compiled to C when a compiler exists) on an executor
 (:mod:`estimate.executor`). Batches are deterministic, so results are identical whichever
 executor runs them.
@@ -32,11 +37,13 @@ __all__ = ["Fit", "read_fit", "draw_parameters", "MonteCarlo", "MonteCarloResult
 
 def draw_parameters(fit: Fit, samples: int, *, seed: int | None = 0,
                     max_rounds: int = 200) -> tuple[np.ndarray, float]:
-    """``samples`` draws of the covariance parameters, truncated to their bounds.
+    """``samples`` draws of the fit's parameters (:attr:`Fit.draw_names`), truncated to
+    their bounds: ``mean + L z + sum_k |z_k| move_k`` (``L L^T`` the covariance,
+    ``move_k`` the estimates' move off the ``k``-th bound per standard deviation).
 
     Returns
     -------
-    draws : array, shape (samples, len(fit.covariance_names))
+    draws : array, shape (samples, len(fit.draw_names))
     acceptance : float
         Fraction of normal draws inside the bounds.
 
@@ -59,7 +66,12 @@ def draw_parameters(fit: Fit, samples: int, *, seed: int | None = 0,
     if w.min() < -1e-10 * max(w.max(), 0.0):
         raise InputError(f"{fit.path}: covariance.matrix is not positive semi-definite "
                          f"(smallest eigenvalue {w.min():.3g})")
-    L = V * np.sqrt(np.clip(w, 0.0, None))
+    names = fit.draw_names
+    L = np.zeros((len(names), len(names)))
+    k = len(fit.covariance_names)
+    L[:k, :k] = V * np.sqrt(np.clip(w, 0.0, None))
+    M = np.array([[move.get(n, 0.0) for n in names] for _, move in fit.off_bounds]).reshape(
+        -1, len(names))
     mu = np.array([fit.values[n] for n in names])
     lo = np.array([fit.lower[n] for n in names])
     hi = np.array([fit.upper[n] for n in names])
@@ -67,8 +79,9 @@ def draw_parameters(fit: Fit, samples: int, *, seed: int | None = 0,
     out, drawn = [], 0
     need = samples
     for _ in range(max_rounds):
-        z = rng.standard_normal((max(need, 64), len(names)))
-        x = mu + z @ L.T
+        rows = max(need, 64)
+        z = rng.standard_normal((rows, len(names)))
+        x = mu + z @ L.T + np.abs(rng.standard_normal((rows, M.shape[0]))) @ M
         drawn += x.shape[0]
         ok = np.all((x >= lo) & (x <= hi), axis=1)
         out.append(x[ok][:need])
@@ -217,13 +230,14 @@ class MonteCarlo:
         for n in names:
             dm.output_index(n)
         _check_memory(samples, len(names), np.size(self.time))
-        unknown = [n for n in self.fit.covariance_names if n not in dm.parameter_names]
+        drawn = self.fit.draw_names
+        unknown = [n for n in drawn if n not in dm.parameter_names]
         if unknown:
             raise InputError(f"covariance parameters {', '.join(unknown)} are not parameters of "
                              f"the model ({', '.join(dm.parameter_names)})")
         base = self.base_vector()
         draws, acceptance = draw_parameters(self.fit, samples, seed=seed)
-        cols = [dm.parameter_names.index(n) for n in self.fit.covariance_names]
+        cols = [dm.parameter_names.index(n) for n in drawn]
         # the draws, then the nominal (the fit's values) as one more column
         P = np.tile(np.nan_to_num(base), (samples + 1, 1))
         P[:samples, cols] = draws
@@ -251,7 +265,7 @@ class MonteCarlo:
         derived = {f"peak_{name}": np.max(np.abs(v), axis=1) for name, v in outputs.items()}
         derived |= derived_quantities(dm, P[:samples])
         return MonteCarloResult(
-            time=t, parameter_names=self.fit.covariance_names, draws=draws, outputs=outputs,
+            time=t, parameter_names=drawn, draws=draws, outputs=outputs,
             derived=derived, seed=seed, acceptance=acceptance,
             seconds=_time.perf_counter() - start, nominal=nominal,
             executor=f"{type(executor).__name__} ({executor.workers} worker"

@@ -67,12 +67,13 @@ def run(args: argparse.Namespace) -> int:
     for note in fit_notes(args.fit, force=args.force):
         print(f"warning: {note}", file=sys.stderr)
     fit = read_fit(args.fit)
-    held = [n for n in fit.estimated if n not in fit.covariance_names]
+    held = [n for n in fit.estimated if n not in fit.draw_names]
     if held:
         print(f"warning: {args.fit}: {', '.join(f'`{n}`' for n in held)} ended on a bound "
-              "and has no covariance: the draws hold it at its value, while the fit's 95 % "
-              "intervals reach off the bound, so the envelope can be narrower than they say",
-              file=sys.stderr)
+              "and the record says nothing of how far the data allow it off the bound (a "
+              "record of an older version, or an estimate the data do not determine): the "
+              "draws hold it at its value, so the envelope can be narrower than the fit's "
+              "95 % intervals", file=sys.stderr)
     case = load_case(args.case, strict=args.strict)
     exp = experiment(case, model_from_spec(args.model or fit.model_spec, case))
     with executor_for(args.scheduler, local=args.local, n_workers=args.workers) as ex:

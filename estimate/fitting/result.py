@@ -177,6 +177,13 @@ class FitResult(ResultIntervals):
     #: just inside a bound; the intervals add this reach times the one-sided quantile
     #: (:meth:`interval`). Zero when nothing is held or nothing correlates with it.
     bound_reach: np.ndarray | None = field(default=None, repr=False)
+    #: Per estimate held at a physical bound that the data determine (a finite
+    #: ``bound_stderr``) and per active linear bound: its label (the estimate's name, or the
+    #: bound in words) and how every estimate moves (``names`` order) when it leaves the
+    #: bound by one standard deviation (the held estimate by its ``bound_stderr`` away from
+    #: the bound, the others along the regression): the columns ``bound_reach`` sums. A
+    #: Monte Carlo of the fit draws along them (half-normal).
+    bound_directions: tuple[tuple[str, np.ndarray], ...] = field(default=(), repr=False)
     #: Per derived quantity, ``(standard error, down, up)`` for its interval: the standard
     #: error conditional on the held estimates (``derived`` has none for a quantity that
     #: depends on one) and its reach as ``bound_reach``.

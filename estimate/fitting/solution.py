@@ -197,11 +197,27 @@ def fit_result(problem: FitProblem, solve: Solve) -> FitResult:
         initial_state_kinds=solve.initial_state_kinds, initial_states=solve.initial_states,
         at_bound=at_bound, bound_stderr=bound_stderr,
         bound_reach=None if reach is None else np.where(free[:, None], reach_sides(reach), 0.0),
+        bound_directions=_directions(problem, reach, held, bound_stderr, active),
         derived_reach=derived_reach,
         active_bounds=tuple(b.text for b in active), noise_figures=figures,
         gauss_newton_covariance=unc.covariance, robust_covariance=robust,
         covariance_kind=kind, bandwidths=unc.bandwidths, model_error=widen,
     )
+
+
+def _directions(problem: FitProblem, reach: np.ndarray | None, held: np.ndarray,
+                bound_stderr: np.ndarray | None, active) -> tuple[tuple[str, np.ndarray], ...]:
+    """:attr:`FitResult.bound_directions` from the reach columns (one per estimate, then one
+    per active linear bound): those of held estimates the data determine, and the linear
+    bounds'."""
+    if reach is None:
+        return ()
+    n = len(problem.names)
+    out = [(problem.names[h], reach[:, h].copy()) for h in range(n)
+           if held[h] and bound_stderr is not None and np.isfinite(bound_stderr[h])
+           and np.any(reach[:, h])]
+    out += [(b.text, reach[:, n + k].copy()) for k, b in enumerate(active)]
+    return tuple(out)
 
 
 def _on_linear_bound(bound, problem: FitProblem, theta: np.ndarray) -> bool:

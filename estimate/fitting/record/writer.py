@@ -134,7 +134,13 @@ def fit_record(result: "FitResult", *, model_spec: str | None = None,
         "parameters": _parameters(result),
         # estimates at a bound have no covariance: both matrices hold the others only
         "covariance": {"parameters": [nm for nm, f in zip(result.names, free) if f],
-                       "matrix": result.covariance[np.ix_(free, free)].tolist()},
+                       "matrix": result.covariance[np.ix_(free, free)].tolist(),
+                       # how the estimates move off each bound the covariance holds, per
+                       # standard deviation (FitResult.bound_directions)
+                       "off_bounds": [{"bound": label,
+                                       "move": {nm: float(v) for nm, v in zip(result.names, col)
+                                                if v != 0.0}}
+                                      for label, col in result.bound_directions]},
         "correlation": result.correlation[np.ix_(free, free)].tolist(),
         "initial_states": {e.case.test.id: dict(x) for e, x in
                            zip(experiments, result.initial_states)},

@@ -166,10 +166,77 @@ def test_cli_montecarlo_local(tmp_path, capsys):
                  "--local", "--out", str(out)]) == 2  # exists, no --overwrite
 
 
+def test_draws_leave_a_held_bound_half_normally_with_the_estimates_that_move_with_it(tmp_path):
+    """A spring held at 0 with its move off the bound (``covariance.off_bounds``): it is
+    drawn as ``|z| s`` (half-normal: mean ``s sqrt(2/pi)``, variance ``s^2 (1 - 2/pi)``) and
+    the length moves with it by ``|z| d``, on top of its covariance. The sample moments of
+    40,000 draws against those formulas (SAMPLE_MOMENTS of the standard deviations)."""
+    path = fit_json(tmp_path / "fit.json")
+    data = json.loads(path.read_text())
+    data["parameters"]["p1.stiffness"] |= {"estimated": True, "at_bound": "lower"}
+    s, d = 0.02, -4e-4
+    data["covariance"]["off_bounds"] = [{"bound": "p1.stiffness",
+                                         "move": {"p1.stiffness": s, "p1.length": d}}]
+    path.write_text(json.dumps(data))
+    fit = read_fit(path)
+    assert fit.draw_names == (*COV_NAMES, "p1.stiffness")
+    draws, acceptance = draw_parameters(fit, 40000, seed=4)
+    k, L = draws[:, 4], draws[:, 2]
+    assert k.min() >= 0.0
+    assert acceptance > 0.99  # drawn off the bound, not half rejected at it
+    h_mean, h_var = math.sqrt(2 / math.pi), 1 - 2 / math.pi
+    assert abs(k.mean() - s * h_mean) < SAMPLE_MOMENTS * s
+    assert abs(k.std() - s * math.sqrt(h_var)) < SAMPLE_MOMENTS * s
+    sd_L = math.sqrt(COV[2, 2] + d**2 * h_var)
+    assert abs(L.mean() - (0.05529 + d * h_mean)) < SAMPLE_MOMENTS * sd_L
+    assert abs(L.std() - sd_L) < SAMPLE_MOMENTS * sd_L
+    assert abs(np.cov(k, L)[0, 1] - s * d * h_var) < SAMPLE_MOMENTS * s * sd_L
+    # the others keep their covariance
+    emp = np.cov(draws[:, :2].T)
+    sd = np.sqrt(np.diag(COV[:2, :2]))
+    assert np.all(np.abs(emp - COV[:2, :2]) < SAMPLE_MOMENTS * np.outer(sd, sd))
+
+
+def test_a_fit_record_keeps_the_moves_off_its_held_bounds_and_the_draws_reach_its_intervals(
+        tmp_path):
+    """The bundled example's fit holds the spring at 0 (its intervals reach off the bound,
+    the length's most: the frequency fixes g/L + k/(m L^2)). Its record keeps the move off
+    the bound: the spring by its one-sided standard deviation, the others by the reach the
+    intervals use. The Monte Carlo draws then cover the length's interval: their 97.5th
+    percentile lies at or above its upper end (the half-normal reaches 1.96 standard
+    deviations where the one-sided limit is 1.645), and every spring draw is >= 0."""
+    from pathlib import Path
+
+    from estimate import FitProblem, fit, load_case, model_from_spec
+
+    case = load_case(Path(__file__).resolve().parents[3] / "examples" / "A1.toml")
+    res = fit(FitProblem.build(case, model_from_spec("fixed,p1", case)))
+    i = res.names.index("p1.stiffness")
+    assert res.at_bound[i] == "lower"
+    path = tmp_path / "fit.json"
+    path.write_text(json.dumps(res.to_dict()))
+    record = read_fit(path)
+    (label, move), = record.off_bounds
+    assert label == "p1.stiffness"
+    assert move["p1.stiffness"] == pytest.approx(res.bound_stderr[i], rel=1e-12)
+    for j, name in enumerate(res.names):
+        if name in move and name not in ("rig.lag", "p1.stiffness"):  # the others
+            assert (max(-move[name], 0), max(move[name], 0)) == pytest.approx(
+                tuple(res.bound_reach[j]), rel=1e-12)
+    draws, _ = draw_parameters(record, 20000, seed=6)
+    names = record.draw_names
+    assert draws[:, names.index("p1.stiffness")].min() >= 0.0
+    length = draws[:, names.index("p1.length")]
+    lo, hi = res.interval("p1.length")
+    assert hi - lo > 10 * res.stderr[res.names.index("p1.length")]  # the reach dominates
+    assert np.percentile(length, 97.5) >= hi
+
+
 def test_cli_montecarlo_says_the_draws_hold_an_estimate_at_its_bound(tmp_path, capsys):
     """A fit record whose spring was estimated and ended on 0 (written as `slosh fit` does:
-    estimated, at_bound, no covariance): the draws cannot move it, and the command says so
-    beside the intervals that do; a record without one gets no such warning."""
+    estimated, at_bound, no covariance) without its move off the bound (an older record):
+    the draws cannot move it, and the command says so beside the intervals that do; a
+    record without a held estimate, or with its move, gets no such warning."""
     from pathlib import Path
 
     from estimate.cli import main
@@ -185,6 +252,13 @@ def test_cli_montecarlo_says_the_draws_hold_an_estimate_at_its_bound(tmp_path, c
     assert main([*run, "--out", str(tmp_path / "b")]) == 0
     err = capsys.readouterr().err
     assert "`p1.stiffness` ended on a bound" in err and "narrower" in err
+    data["covariance"]["off_bounds"] = [{"bound": "p1.stiffness",
+                                         "move": {"p1.stiffness": 0.02, "p1.length": -4e-4}}]
+    fit.write_text(json.dumps(data))
+    assert main([*run, "--out", str(tmp_path / "c")]) == 0
+    assert "ended on a bound" not in capsys.readouterr().err
+    mc = json.loads((tmp_path / "c" / "montecarlo.json").read_text())
+    assert "p1.stiffness" in mc["parameters"]
 
 
 def test_cli_export_c_and_fmu(tmp_path, capsys):
