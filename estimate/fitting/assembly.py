@@ -209,6 +209,8 @@ class AssembledNlp:
                                                              [*shared, r]))
             self._keep.append(once)  # alive as long as the solver that calls it
             *shared, r = once(self.w)
+            if blocks:
+                self._served.update(f=0.5 * ca.sumsqr(r) / self.norm, g=shared[0])
         if blocks:
             opts["jac_g"] = ca.Function("nlp_jac_g", [self.w, ca.MX(0, 1)], shared[:2],
                                         ["x", "p"], ["g", "jac_g_x"])
@@ -233,6 +235,17 @@ class AssembledNlp:
     @cached_property
     def _keep(self) -> list:
         return []
+
+    @cached_property
+    def _served(self) -> dict:
+        return {}
+
+    def solver_functions(self, g: ca.MX) -> tuple[ca.MX, ca.MX]:
+        """``(f, g)`` as IPOPT evaluates them: from the once-per-point Jacobians when
+        :meth:`derivative_options` made them (IPOPT asks for f and g at the point where it
+        then asks for their derivatives: one simulation per point, not three), else
+        :attr:`f` and ``g``."""
+        return self._served.get("f", self.f), self._served.get("g", g)
 
     def release_buffers(self) -> None:
         """Free the memory the solver's once-per-point Jacobians keep between calls."""

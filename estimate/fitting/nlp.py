@@ -239,7 +239,8 @@ def _solve(problem: FitProblem, transcription: Transcription, hessian: Hessian, 
         g = nlp.g_fast
         opts.update({"no_nlp_grad": True, "calc_lam_p": False})
     opts.update(dict(solver_options or {}))
-    solver = ca.nlpsol("fit", "ipopt", {"x": nlp.w, "f": nlp.f, "g": g}, opts)
+    f, g = nlp.solver_functions(g)
+    solver = ca.nlpsol("fit", "ipopt", {"x": nlp.w, "f": f, "g": g}, opts)
     lbx, ubx = nlp.bounds(est)
     lbg, ubg = nlp.constraint_bounds()
     with surfacing():  # an interrupt inside IPOPT is an interruption, not a non-convergence
