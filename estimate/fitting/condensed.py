@@ -156,11 +156,12 @@ def condensed_block(dm: DerivedModel, substeps: int, K: int, p: ca.MX, t: np.nda
         nU = int(U.size1())
         pad = m * K - (n - 1)
         Up = ca.horzcat(U, ca.DM.zeros(nU, pad)) if pad else U
-        inputs = [(Up[:, j::K],) for j in range(K)]  # step j of every interval: nU x m
+        # step j of every interval: nU x m (MX: one constant for the three runs)
+        inputs = [(ca.MX(Up[:, j::K]),) for j in range(K)]
     width = 0 if win is None else win.width
     # step j of every interval: start times and lengths (1 x m)
-    tj = [ca.DM(tk[j::K]).T for j in range(K)]
-    hj = [ca.DM(hk[j::K]).T for j in range(K)]
+    tj = [ca.MX(dense_dm(tk[j::K]).T) for j in range(K)]
+    hj = [ca.MX(dense_dm(hk[j::K]).T) for j in range(K)]
     nodes = np.arange(m) * K
     fixed = x0 is not None
     W = ca.MX.sym("X", nx, m - 1 if fixed else m)
@@ -323,7 +324,9 @@ class _Windows:
         flat -= start[k]
         L = np.zeros((K, nU, m, width))
         L.ravel()[flat] = C.data
-        basis = [dense_dm(L[j].reshape(nU, m * width)) for j in range(K)]
+        # MX constants: the block passes them to three mapped runs (simulation, compiled
+        # simulation, sensitivities), and a DM argument would be copied into each
+        basis = [ca.MX(dense_dm(L[j].reshape(nU, m * width))) for j in range(K)]
         return cls(start, width, lo - start, hi - start, basis, nc)
 
     def grid_bases(self, A_grid, nu: int, K: int, n: int) -> tuple[ca.MX, ca.DM]:
