@@ -96,7 +96,6 @@ def _physical_step(lin: Linearisation, base: tuple[str, ...], term: Term, reduct
                 continue
             r, v = lin.score(base + free)
             v = {**v, **{n: float(lin.values[lin.names.index(n)]) for n in held}}
-            if not _unphysical(term, v, held) and (
-                    best is None or r > best[0]):
+            if not _unphysical(term, v, held) and (best is None or r > best[0]):
                 best = (r, v, held)
     return best if best is not None else (reduction, values, ())
