@@ -55,8 +55,7 @@ def draw_parameters(fit: Fit, samples: int, *, seed: int | None = 0,
     """
     if samples < 1:
         raise InputError(f"samples must be at least 1, got {samples}")
-    names = fit.covariance_names
-    if not names:
+    if not fit.covariance_names:
         raise InputError(f"{fit.path}: the fit has no covariance; Monte Carlo needs "
                          "`covariance.parameters` and `covariance.matrix`")
     C = fit.covariance

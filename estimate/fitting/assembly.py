@@ -191,11 +191,16 @@ class AssembledNlp:
         ubx[: len(est)] = [e.upper / e.scale for e in est]
         return lbx, ubx
 
-    def derivative_options(self, hessian: Hessian, blocks_ok: bool) -> dict:
-        """``jac_g`` assembled from per-interval blocks, the objective's gradient
-        ``J_r^T r / norm`` from the assembled ``J_r`` and the Gauss-Newton ``hess_lag``.
-        The Jacobians they share are evaluated once per iterate (:class:`OncePerPoint`)."""
+    def derivative_options(self, hessian: Hessian, blocks_ok: bool
+                           ) -> tuple[dict, ca.MX, ca.MX | None]:
+        """``(options, f, g)``: the options give ``jac_g`` assembled from per-interval
+        blocks, the objective's gradient ``J_r^T r / norm`` from the assembled ``J_r`` and
+        the Gauss-Newton ``hess_lag``. The Jacobians they share are evaluated once per
+        iterate (:class:`OncePerPoint`), and then ``f`` and ``g`` are read from them too
+        (IPOPT asks for f and g at the point where it then asks for their derivatives: one
+        simulation per point, not three); else ``f`` is :attr:`f` and ``g`` ``None``."""
         opts: dict = {}
+        f, g = self.f, None
         blocks = self.constraint_blocks(blocks_ok)
         jac_r = self.jac_r if (self.assembled_jac_r or hessian.kind == "gauss-newton") else None
         shared = [*(blocks or ()), *(() if jac_r is None else (jac_r,))]
@@ -210,7 +215,7 @@ class AssembledNlp:
             self._keep.append(once)  # alive as long as the solver that calls it
             *shared, r = once(self.w)
             if blocks:
-                self._served.update(f=0.5 * ca.sumsqr(r) / self.norm, g=shared[0])
+                f, g = 0.5 * ca.sumsqr(r) / self.norm, shared[0]
         if blocks:
             opts["jac_g"] = ca.Function("nlp_jac_g", [self.w, ca.MX(0, 1)], shared[:2],
                                         ["x", "p"], ["g", "jac_g_x"])
@@ -230,22 +235,11 @@ class AssembledNlp:
             opts["hess_lag"] = ca.Function("nlp_hess_l", [self.w, ca.MX(0, 1), sigma, lam],
                                            [ca.triu(H)], ["x", "p", "lam_f", "lam_g"],
                                            ["triu_hess_gamma_x_x"])
-        return opts
+        return opts, f, g
 
     @cached_property
     def _keep(self) -> list:
         return []
-
-    @cached_property
-    def _served(self) -> dict:
-        return {}
-
-    def solver_functions(self, g: ca.MX) -> tuple[ca.MX, ca.MX]:
-        """``(f, g)`` as IPOPT evaluates them: from the once-per-point Jacobians when
-        :meth:`derivative_options` made them (IPOPT asks for f and g at the point where it
-        then asks for their derivatives: one simulation per point, not three), else
-        :attr:`f` and ``g``."""
-        return self._served.get("f", self.f), self._served.get("g", g)
 
     def release_buffers(self) -> None:
         """Free the memory the solver's once-per-point Jacobians keep between calls."""

@@ -227,7 +227,8 @@ def _solve(problem: FitProblem, transcription: Transcription, hessian: Hessian, 
                               warm_start)
     opts = dict(IPOPT_DEFAULTS)
     opts["ipopt.mumps_pivot_order"] = pivot_order(problem)
-    opts.update(nlp.derivative_options(hessian, blocks_ok))
+    derivatives, f, g_once = nlp.derivative_options(hessian, blocks_ok)
+    opts.update(derivatives)
     recorder = Recorder(nlp.w.numel(), nlp.g.numel(), len(est), scales, 2 * nlp.norm,
                          progress_printer(problem.names) if progress else None)
     opts["iteration_callback"] = recorder
@@ -236,10 +237,9 @@ def _solve(problem: FitProblem, transcription: Transcription, hessian: Hessian, 
         # IPOPT gets g and its Jacobian from the per-interval functions (compiled when a
         # compiler exists), and CasADi builds no AD of g: nothing asks for it once the
         # multipliers of the (absent) NLP parameters are not computed
-        g = nlp.g_fast
+        g = nlp.g_fast if g_once is None else g_once
         opts.update({"no_nlp_grad": True, "calc_lam_p": False})
     opts.update(dict(solver_options or {}))
-    f, g = nlp.solver_functions(g)
     solver = ca.nlpsol("fit", "ipopt", {"x": nlp.w, "f": f, "g": g}, opts)
     lbx, ubx = nlp.bounds(est)
     lbg, ubg = nlp.constraint_bounds()

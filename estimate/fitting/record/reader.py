@@ -243,8 +243,11 @@ def _off_bounds(cov: Any, values: Mapping, problems: list[str]
     raw = cov.get("off_bounds") if isinstance(cov, Mapping) else None
     if raw is None:
         return ()
+    if not isinstance(raw, list):
+        problems.append(f"`covariance.off_bounds`: expected a list, found {raw!r}"[:300])
+        return ()
     out = []
-    for i, entry in enumerate(raw if isinstance(raw, list) else [raw]):
+    for i, entry in enumerate(raw):
         where = f"`covariance.off_bounds[{i}]`"
         move = entry.get("move") if isinstance(entry, Mapping) else None
         if not (isinstance(entry, Mapping) and isinstance(entry.get("bound"), str)
@@ -330,8 +333,8 @@ def read_fit(path: str | Path) -> Fit:
             del d[k]
     return Fit(path=path, model_spec=str(spec), case=case, values=values, units=units,
                lower=lower, upper=upper, estimated=tuple(estimated), covariance_names=names,
-               covariance=matrix, off_bounds=off_bounds, stderr=stderr, intervals=intervals, derived=derived,
-               derived_intervals=derived_intervals,
+               covariance=matrix, off_bounds=off_bounds, stderr=stderr, intervals=intervals,
+               derived=derived, derived_intervals=derived_intervals,
                converged=converged if isinstance(converged, bool) else None,
                status=status if isinstance(status, str) else None,
                r_squared=float(data["r_squared"]) if _is_number(data.get("r_squared"))

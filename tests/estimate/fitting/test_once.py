@@ -68,8 +68,7 @@ def test_ipopt_objective_and_constraints_come_from_the_once_per_point_jacobians(
     problem = FitProblem.build(case, model_from_spec("fixed,p1:nospring", case))
     kinds = [e.initial_state_kind for e in problem.experiments]
     nlp, _ = assemble_nlp(problem, MultipleShooting(), "squared", kinds, True, None, None)
-    opts = nlp.derivative_options(Hessian(), True)
-    f, g = nlp.solver_functions(nlp.g_fast)
+    opts, f, g = nlp.derivative_options(Hessian(), True)
     F = ca.Function("f", [nlp.w], [f, g])
     direct = ca.Function("direct", [nlp.w], [nlp.f, nlp.g])
     w0 = nlp.w0
