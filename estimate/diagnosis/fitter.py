@@ -223,9 +223,10 @@ class Fitter:
         # a warm start is in the current fit's valley, whose own fit (the baseline, cold)
         # had the refit without the liquid bound: a candidate that ends on the bound is not
         # fitted again without it (a record whose analog holds all the liquid spent 0.8 s
-        # per candidate on refits it discarded)
+        # per candidate on refits it discarded). A candidate the record does not determine
+        # is judged as fitted, not refitted with parts of it held.
         res = fit(prob, progress=False, solver_options=budget.options(self.samples),
-                  warm_start=warm, unbounded_retry=warm is None)
+                  warm_start=warm, unbounded_retry=warm is None, hold_undetermined=False)
         self.log.append(FitRecord(purpose, budget.kind, res.iterations, res.seconds, res.status,
                                   _ENDED_BY.get(res.status)))
         self._holds[id(res)] = {**self.held, **(hold or {})}

@@ -12,16 +12,21 @@ __all__ = ["Recorder", "progress_printer"]
 
 
 class Recorder(ca.Callback):
-    """IPOPT iteration callback: records parameter trajectories and prints progress."""
+    """IPOPT iteration callback: records parameter trajectories and prints progress; asks
+    IPOPT to stop (status ``User_Requested_Stop``) when ``stop(costs, thetas)`` says so
+    (the costs ``|r|^2`` and estimates of the iterations so far)."""
 
     def __init__(self, nw: int, ng: int, ntheta: int, scales: np.ndarray, cost_scale: float,
-                 printer: Callable[[int, float, np.ndarray], None] | None) -> None:
+                 printer: Callable[[int, float, np.ndarray], None] | None,
+                 stop: Callable[[list[float], list[np.ndarray]], bool] | None = None) -> None:
         ca.Callback.__init__(self)
         self.nw, self.ng, self.ntheta = nw, ng, ntheta
         self.scales, self.cost_scale = scales, cost_scale
         self.thetas: list[np.ndarray] = []
         self.costs: list[float] = []
         self.printer = printer
+        self.stop = stop
+        self.stopped = False  # whether ``stop`` ended the solve
         self.construct("fit_iterations", {})
 
     def get_n_in(self):
@@ -53,7 +58,8 @@ class Recorder(ca.Callback):
         self.costs.append(cost)
         if self.printer is not None:
             self.printer(len(self.costs) - 1, cost, theta)
-        return [0]
+        self.stopped = self.stop is not None and self.stop(self.costs, self.thetas)
+        return [int(self.stopped)]
 
 
 def progress_printer(names):

@@ -36,6 +36,7 @@ from .solution import LOW_R_SQUARED, Solve, fit_result
 from .starts import second_start
 from .strategies import Cost, cost_of
 from .transcription import MultipleShooting, Transcription
+from .vanished import STALLED, stall_stop
 
 __all__ = ["IPOPT_DEFAULTS", "LOW_R_SQUARED", "fit", "Hessian"]
 
@@ -86,7 +87,7 @@ def fit(problem: FitProblem, *, transcription: Transcription = MultipleShooting(
         solver_options: Mapping[str, object] | None = None,
         progress: bool | None = None, robust_start: bool = True,
         compile_: bool | None = None, warm_start: FitResult | None = None,
-        balance: bool = True, unbounded_retry: bool = True,
+        balance: bool = True, unbounded_retry: bool = True, hold_undetermined: bool = True,
         _free_retry: bool = True) -> FitResult:
     """Estimate the parameters of ``problem``.
 
@@ -137,6 +138,11 @@ def fit(problem: FitProblem, *, transcription: Transcription = MultipleShooting(
         if it converges inside the bound with a smaller residual (a bound met on the way
         can hold the solver in another valley). ``False`` where the start is known to be
         in the right valley (a warm start from a fit that had its own retry).
+    hold_undetermined : bool, default True
+        When the fit does not converge because the record does not determine a mode (its
+        mass vanished, or its estimates wandered without changing the cost: the fit stops
+        then, status ``"Stalled"``), refit with that mode's other parameters held at their
+        starts (:mod:`estimate.fitting.vanished`); the note says so.
 
     Returns
     -------
@@ -173,7 +179,8 @@ def fit(problem: FitProblem, *, transcription: Transcription = MultipleShooting(
                    initial_state=initial_state, solver_options=solver_options,
                    progress=progress, compile_=compile_, warm_start=warm_start,
                    balance=balance, free_retry=_free_retry,
-                   unbounded_retry=unbounded_retry, t_start=t_start)
+                   unbounded_retry=unbounded_retry, hold_undetermined=hold_undetermined,
+                   t_start=t_start)
 
 
 def _better_start(problem: FitProblem, result: FitResult, other: FitProblem, why: str,
@@ -230,7 +237,8 @@ def _solve(problem: FitProblem, transcription: Transcription, hessian: Hessian, 
     derivatives, f, g_once = nlp.derivative_options(hessian, blocks_ok)
     opts.update(derivatives)
     recorder = Recorder(nlp.w.numel(), nlp.g.numel(), len(est), scales, 2 * nlp.norm,
-                         progress_printer(problem.names) if progress else None)
+                         progress_printer(problem.names) if progress else None,
+                         stall_stop(problem, int(nlp.r.numel())))
     opts["iteration_callback"] = recorder
     g = nlp.g
     if "jac_g" in opts:
@@ -259,6 +267,9 @@ def _solve(problem: FitProblem, transcription: Transcription, hessian: Hessian, 
     initial_states = tuple(
         dict(zip(e.derived.states, np.asarray(x, float).ravel().tolist()))
         for e, x in zip(problem.experiments, nlp.initial_states(w_opt)))
-    return fit_result(problem, Solve(theta, solver.stats(), recorder, tuple(terms), out, J, Je,
+    stats = solver.stats()
+    if recorder.stopped:  # the cost stalled (not an interrupt: `surfacing` raises those)
+        stats = {**stats, "return_status": STALLED, "success": False}
+    return fit_result(problem, Solve(theta, stats, recorder, tuple(terms), out, J, Je,
                                      Jg, t_start, transcription, cost, tuple(kinds),
                                      initial_states))

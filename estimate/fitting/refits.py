@@ -14,6 +14,7 @@ from .noise_figures import reweighed
 from .problem import FitProblem
 from .result import FitResult
 from .transcription import Transcription
+from .vanished import held_refit
 
 if TYPE_CHECKING:
     from .nlp import Hessian
@@ -29,7 +30,8 @@ def refined(problem: FitProblem, result: FitResult, *, transcription: Transcript
             hessian: Hessian, cost: str, initial_state: str | None,
             solver_options: Mapping[str, object] | None, progress: bool,
             compile_: bool | None, warm_start: FitResult | None, balance: bool,
-            free_retry: bool, t_start: float, unbounded_retry: bool = True) -> FitResult:
+            free_retry: bool, t_start: float, unbounded_retry: bool = True,
+            hold_undetermined: bool = True) -> FitResult:
     """``result`` (a solve of ``problem``), or the refit that replaces it.
 
     Parameters
@@ -46,6 +48,10 @@ warm_start, balance
         inside a refit).
     unbounded_retry : bool
         Whether the refit without the liquid bound may run (``fit``'s option).
+    hold_undetermined : bool
+        Whether a fit that did not converge is refitted with the parameters of a mode the
+        record does not determine held (:mod:`estimate.fitting.vanished`; ``fit``'s
+        option).
     t_start : float
         ``time.perf_counter()`` when the fit started [s]: a refit's result counts the
         time since.
@@ -75,6 +81,18 @@ warm_start, balance
                                   compile_=compile_, balance=balance, _free_retry=False)
         if inside is not None:
             return replace(inside, iterations=result.iterations + inside.iterations,
+                           seconds=time.perf_counter() - t_start)
+    if not result.converged and free_retry and hold_undetermined:
+        held = held_refit(problem, result.values, result.history, result.status,
+                          result.iterations)
+        if held is not None:
+            again, note = held
+            again = replace(again, notes=again.notes + (note,))
+            second = fit(again, transcription=transcription, hessian=hessian, cost=cost,
+                         initial_state=initial_state, solver_options=solver_options,
+                         progress=progress, robust_start=False, compile_=compile_,
+                         warm_start=result, balance=balance, _free_retry=False)
+            return replace(second, iterations=result.iterations + second.iterations,
                            seconds=time.perf_counter() - t_start)
     if not result.converged:
         # a fit that did not converge (its iterations or time budget spent) is no place to

@@ -32,6 +32,8 @@ _IPOPT_HINTS = {
     "Restoration_Failed": "the initial guess is far from feasible: check the excitation and the "
                           "initial values",
     "Infeasible_Problem_Detected": "bounds exclude every solution: widen `bounds`",
+    "Stalled": "the cost changed by less than the noise over many iterations: the record does "
+               "not determine some parameters (hold them, or drop what the record does not show)",
     "Invalid_Number_Detected": "a parameter reached a value where the model is undefined: "
                                "tighten bounds",
 }
