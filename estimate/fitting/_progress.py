@@ -27,6 +27,8 @@ class Recorder(ca.Callback):
         self.printer = printer
         self.stop = stop
         self.stopped = False  # whether ``stop`` ended the solve
+        #: The last iterate (all decision variables) whose cost was finite.
+        self.last_finite: ca.DM | None = None
         self.construct("fit_iterations", {})
 
     def get_n_in(self):
@@ -56,6 +58,8 @@ class Recorder(ca.Callback):
         cost = float(arg[1]) * self.cost_scale
         self.thetas.append(theta)
         self.costs.append(cost)
+        if np.isfinite(cost) and np.all(np.isfinite(theta)):
+            self.last_finite = ca.DM(arg[0])  # a copy in C++: converted only when used
         if self.printer is not None:
             self.printer(len(self.costs) - 1, cost, theta)
         self.stopped = self.stop is not None and self.stop(self.costs, self.thetas)

@@ -110,6 +110,14 @@ def uncertainty(jac_residuals: sps.spmatrix, jac_constraints: sps.spmatrix,
     nw, ng = Je.shape[1], Jg.shape[0]
     k = nw - ng  # estimated quantities: variables the constraints leave free
     sigma2 = float(residuals @ residuals) / max(n_observations - k, 1)
+    if not (np.isfinite(Je.data).all() and np.isfinite(Jg.data).all() and np.isfinite(sigma2)):
+        # a fit that diverged (IPOPT's Invalid_Number_Detected: a 60 s spinning-rig record
+        # whose simulation overflowed) ends where its sensitivities are not numbers
+        nan = np.full((ntheta, ntheta), np.nan)
+        return Uncertainty(nan, np.full(ntheta, np.nan), nan.copy(), sigma2,
+                           Identifiability(np.zeros(0), float("inf"), (), ()),
+                           ("the fit ended where the model's sensitivities are not finite (it "
+                            "diverged): no covariance",), np.full(ntheta, np.nan))
     kkt = ReducedKKT(Je, Jg, ntheta)
     S = kkt.information
     free = np.setdiff1d(np.arange(ntheta), np.asarray(held, int))

@@ -211,6 +211,11 @@ def _better_start(problem: FitProblem, result: FitResult, other: FitProblem, why
 WIDE_KNOT_SAMPLES = 25
 
 
+def _finite(out) -> bool:
+    """Whether the residuals and their Jacobian at a solution are numbers."""
+    return bool(np.all(np.isfinite(out.e)) and np.all(np.isfinite(out.jacobian.nonzeros())))
+
+
 def pivot_order(problem: FitProblem) -> int:
     """MUMPS's ordering for ``problem``'s KKT systems (``ipopt.mumps_pivot_order``): METIS
     (5) when a case's carriage spline has knots more than :data:`WIDE_KNOT_SAMPLES`
@@ -258,9 +263,16 @@ def _solve(problem: FitProblem, transcription: Transcription, hessian: Hessian, 
     w_opt = np.asarray(sol["x"]).ravel()
     # IPOPT may leave a bounded variable a hair outside its bound (its bound_relax_factor)
     theta = np.clip(w_opt[: len(est)] * scales, [e.lower for e in est], [e.upper for e in est])
-    _, Jg = solver.get_function("nlp_jac_g")(w_opt, [])
     nlp.release_buffers()  # the iterates' Jacobians are no longer asked for
     out = nlp.outputs_at(w_opt, cost)
+    if not _finite(out) and recorder.last_finite is not None:
+        # a fit that diverged (Invalid_Number_Detected: a 60 s spinning-rig record whose
+        # simulation overflowed) is reported where it last was finite, not converged
+        w_opt = np.asarray(recorder.last_finite).ravel()
+        theta = np.clip(w_opt[: len(est)] * scales, [e.lower for e in est],
+                        [e.upper for e in est])
+        out = nlp.outputs_at(w_opt, cost)
+    _, Jg = solver.get_function("nlp_jac_g")(w_opt, [])
     Je, Jg = scipy_csc(out.jacobian), scipy_csc(Jg)
     Jg = Jg[: Jg.shape[0] - nlp.n_linear]  # the dynamics; the linear bounds are the masses'
     J = reduced_jacobian(Je, Jg, len(est), scales, list(nlp.free_states))

@@ -14,7 +14,7 @@ from .noise_figures import reweighed
 from .problem import FitProblem
 from .result import FitResult
 from .transcription import Transcription
-from .vanished import held_refit
+from .vanished import HELD_STATUSES, held_refit
 
 if TYPE_CHECKING:
     from .nlp import Hessian
@@ -82,7 +82,7 @@ warm_start, balance
         if inside is not None:
             return replace(inside, iterations=result.iterations + inside.iterations,
                            seconds=time.perf_counter() - t_start)
-    if not result.converged and free_retry and hold_undetermined:
+    if result.status in HELD_STATUSES and free_retry and hold_undetermined:
         held = held_refit(problem, result.values, result.history, result.status,
                           result.iterations)
         if held is not None:

@@ -22,7 +22,7 @@ import numpy as np
 
 from .problem import FitProblem
 
-__all__ = ["RIDGE_ITERATIONS", "RIDGE_WINDOW", "STALLED", "STALL_ITERATIONS", "STALL_WINDOW",
+__all__ = ["HELD_STATUSES", "RIDGE_ITERATIONS", "RIDGE_WINDOW", "STALLED", "STALL_ITERATIONS", "STALL_WINDOW",
            "VANISHED_SHARE", "WANDER_SHARE", "held_refit", "held_value", "stall_stop"]
 
 #: A component's mass has vanished when it is below this share of its start.
@@ -41,6 +41,10 @@ RIDGE_WINDOW, RIDGE_ITERATIONS = 20, 40
 WANDER_SHARE = 0.05
 #: The status of a fit stopped so (not converged).
 STALLED = "Stalled"
+#: The statuses of the fits :func:`held_refit` looks at: stalled, or out of iterations (a
+#: fit that diverged, IPOPT's ``Invalid_Number_Detected``, wandered too, but not along a
+#: ridge of the cost: holding its modes made a 60 s spinning-rig fit worse).
+HELD_STATUSES = (STALLED, "Maximum_Iterations_Exceeded")
 
 
 def _components(problem: FitProblem) -> dict[int, list[int]]:
