@@ -1,13 +1,21 @@
 """The memory budget a record is checked against before anything is allocated for it.
 
 The fit is what needs memory: a multiple-shooting NLP holds states, Jacobian blocks and
-IPOPT's factorisation for every sample. Its peak resident memory grows by 9-13 KiB per
-sample for the baseline model with an estimated carriage motion
-(``benchmarks/bench_length.py``: 30,001, 120,001 and 600,001 samples peak at 0.48, 1.2 and
-6.4 GB); :data:`FIT_BYTES_PER_SAMPLE` rounds that up for larger models. A record needing
-more than the budget is refused with the number of samples it holds and by how much to
-decimate it; slosh modes lie below about 10 Hz, so a few hundred samples per second are
-plenty.
+IPOPT's factorisation for every sample. Its peak resident memory grows per sample by
+(``benchmarks/bench_length.py`` and fits of the same records with larger models):
+
+- 8-11 KiB for the baseline lateral model with an estimated carriage motion (30,001,
+  120,001 and 600,001 samples peak at 0.44, 1.0 and 5.5 GB);
+- 10 KiB with a stream lag, 13 KiB with two modes, a lag and transducer offsets;
+- 40 KiB for the spinning rig's six channels (a rotor and a pendulum).
+
+:data:`FIT_BYTES_PER_SAMPLE` rounds the one-channel figure up, and
+:data:`CHANNEL_BYTES_PER_SAMPLE` adds each further channel (:func:`fit_bytes`: 16 KiB per
+sample for one channel, 46 KiB for six). A record is read only when its fit with one
+channel would fit the budget; :func:`check_fit` checks a fit's cases with their channels
+before the fit allocates them. A record needing more than the budget is refused with the
+number of samples it holds and by how much to decimate it; slosh modes lie below about
+10 Hz, so a few hundred samples per second are plenty.
 """
 
 from __future__ import annotations
@@ -18,15 +26,18 @@ import re
 
 from analogs.errors import InputError
 
-__all__ = ["BUDGET_VARIABLE", "DEFAULT_BUDGET", "FIT_BYTES_PER_SAMPLE", "decimation_hint",
-           "max_samples", "memory_budget", "size_text"]
+__all__ = ["BUDGET_VARIABLE", "CHANNEL_BYTES_PER_SAMPLE", "DEFAULT_BUDGET",
+           "FIT_BYTES_PER_SAMPLE", "check_fit", "decimation_hint", "fit_bytes", "max_samples",
+           "memory_budget", "size_text"]
 
 #: Environment variable that sets the budget, e.g. ``16G``, ``512M`` or a number of bytes.
 BUDGET_VARIABLE = "SLOSH_MEMORY_BUDGET"
 #: Budget when :data:`BUDGET_VARIABLE` is not set [bytes]: 4 GiB.
 DEFAULT_BUDGET = 4 * 2**30
-#: Memory a fit needs per sample of a record [bytes] (see the module docstring).
-FIT_BYTES_PER_SAMPLE = 32 * 2**10
+#: Memory a fit of one measured channel needs per sample [bytes] (module docstring).
+FIT_BYTES_PER_SAMPLE = 16 * 2**10
+#: ... and per sample of each further measured channel [bytes].
+CHANNEL_BYTES_PER_SAMPLE = 6 * 2**10
 
 _UNITS = {"": 1, "K": 2**10, "M": 2**20, "G": 2**30, "T": 2**40}
 
@@ -46,6 +57,28 @@ def memory_budget() -> int:
 def max_samples() -> int:
     """The most samples a record may hold within the budget."""
     return memory_budget() // FIT_BYTES_PER_SAMPLE
+
+
+def fit_bytes(samples: int, channels: int = 1) -> int:
+    """Memory a fit of ``samples`` samples of ``channels`` measured channels needs [bytes]."""
+    return samples * (FIT_BYTES_PER_SAMPLE + max(channels - 1, 0) * CHANNEL_BYTES_PER_SAMPLE)
+
+
+def check_fit(cases: list[tuple[str, int, int]]) -> None:
+    """Raise :class:`~analogs.errors.InputError` when a fit of ``cases`` (name, samples,
+    measured channels) needs more memory than the budget, naming each case's need and by
+    how much to decimate."""
+    need = sum(fit_bytes(n, c) for _, n, c in cases)
+    budget = memory_budget()
+    if need <= budget:
+        return
+    factor = math.ceil(need / budget)
+    parts = ", ".join(f"{name}: {n} samples x {c} channel{'s' if c > 1 else ''} "
+                      f"({size_text(fit_bytes(n, c))})" for name, n, c in cases)
+    raise InputError(f"the fit needs about {size_text(need)} ({parts}), over the memory budget "
+                     f"of {size_text(budget)} (set {BUDGET_VARIABLE} to change it): decimate by "
+                     f"{factor} (low-pass below the new Nyquist frequency, then keep every "
+                     f"{factor}{_ordinal(factor)} row), cut the records or fit fewer channels")
 
 
 def size_text(n_bytes: float) -> str:

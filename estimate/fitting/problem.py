@@ -7,6 +7,7 @@ from __future__ import annotations
 import math
 from collections.abc import Mapping, Sequence
 from dataclasses import dataclass, field, replace
+from pathlib import Path
 
 import numpy as np
 
@@ -280,10 +281,17 @@ class FitProblem:
         return np.array([e.initial for e in self.estimated])
 
     def check(self) -> None:
-        """Raise if an initial value is not finite."""
+        """Raise if an initial value is not finite, or when the fit needs more memory than
+        the budget (:func:`estimate.data.budget.check_fit`: by its cases' samples and
+        measured channels)."""
+        from ..data.budget import check_fit
+
         bad = [e.name for e in self.estimated if not math.isfinite(e.initial)]
         if bad:
             raise InputError(f"initial values are not finite: {', '.join(bad)}")
+        check_fit([(Path(str(x.case.path)).name if x.case.path else f"case {i}",
+                    int(x.case.time.size), len(self.channels(i)))
+                   for i, x in enumerate(self.experiments)])
 
 
 def _held_tie(tie: Tie, label: str, value: float) -> Tie:

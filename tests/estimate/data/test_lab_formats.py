@@ -279,7 +279,7 @@ def test_channels_of_different_lengths_and_non_vectors_are_refused(tmp_path):
 
 def test_the_memory_budget_is_checked_before_reading(tmp_path, monkeypatch):
     _mat5(tmp_path)
-    monkeypatch.setenv("SLOSH_MEMORY_BUDGET", "64M")  # 2048 samples
+    monkeypatch.setenv("SLOSH_MEMORY_BUDGET", "32M")  # 2048 samples
     message = _one_problem(_case(tmp_path, "A1_v5.mat", MAT5_COLUMNS))
     assert message.startswith("A1_v5.mat: channel `t`: 3001 samples; a fit needs"), message
     assert "decimate by 2" in message

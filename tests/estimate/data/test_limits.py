@@ -12,7 +12,7 @@ import pytest
 
 from analogs.errors import InputError
 from estimate.data import CaseError, load_case
-from estimate.data.budget import FIT_BYTES_PER_SAMPLE, max_samples, memory_budget
+from estimate.data.budget import FIT_BYTES_PER_SAMPLE, check_fit, fit_bytes, max_samples, memory_budget
 from estimate.data.signals import lowpass
 
 EXAMPLES = Path(__file__).resolve().parents[3] / "examples"
@@ -52,13 +52,29 @@ def test_ten_million_rows_are_refused_in_seconds_without_reading_them(tmp_path, 
     tracemalloc.stop()
     msg = str(info.value)
     assert "big.csv: rows: 10000000 samples" in msg and "memory budget of 4 GiB" in msg
-    assert "decimate by 77" in msg and "SLOSH_MEMORY_BUDGET" in msg
+    assert "decimate by 39" in msg and "SLOSH_MEMORY_BUDGET" in msg
     assert peak < 16 * 2**20, peak  # a few chunks, never the rows
     assert seconds < 20.0, seconds
 
 
+def test_a_fit_is_checked_with_its_channels(monkeypatch):
+    """The measured peaks (``estimate.data.budget``): 8-13 KiB per sample for lateral
+    fits of one channel, 40 KiB for the spinning rig's six; the check counts 16 KiB and 46
+    KiB, so a six-channel record that reads within the budget is refused at its fit,
+    naming the case, its channels and how much to decimate."""
+    monkeypatch.setenv("SLOSH_MEMORY_BUDGET", "1G")
+    assert fit_bytes(1000, 1) == 16 * 2**10 * 1000
+    assert fit_bytes(1000, 6) == 46 * 2**10 * 1000
+    check_fit([("lateral.csv", 60_000, 1)])  # 0.92 GiB
+    with pytest.raises(InputError) as info:
+        check_fit([("spin.csv", 60_000, 6)])
+    msg = str(info.value)
+    assert "spin.csv: 60000 samples x 6 channels" in msg and "memory budget of 1 GiB" in msg
+    assert "decimate by 3" in msg
+
+
 def test_a_record_within_a_larger_budget_is_read(tmp_path, monkeypatch):
-    monkeypatch.setenv("SLOSH_MEMORY_BUDGET", "64M")  # 2048 samples
+    monkeypatch.setenv("SLOSH_MEMORY_BUDGET", "32M")  # 2048 samples
     lines = (EXAMPLES / "A1.csv").read_bytes().splitlines(keepends=True)
     with pytest.raises(CaseError, match="3001 samples.*decimate by 2"):
         load_case(_case(tmp_path, b"".join(lines)))
