@@ -224,9 +224,11 @@ class Fitter:
         # had the refit without the liquid bound: a candidate that ends on the bound is not
         # fitted again without it (a record whose analog holds all the liquid spent 0.8 s
         # per candidate on refits it discarded). A candidate the record does not determine
-        # is judged as fitted, not refitted with parts of it held.
+        # is judged as fitted, not refitted with parts of it held or from a part of the
+        # record.
         res = fit(prob, progress=False, solver_options=budget.options(self.samples),
-                  warm_start=warm, unbounded_retry=warm is None, hold_undetermined=False)
+                  warm_start=warm, unbounded_retry=warm is None, hold_undetermined=False,
+                  segment_start=False)
         self.log.append(FitRecord(purpose, budget.kind, res.iterations, res.seconds, res.status,
                                   _ENDED_BY.get(res.status)))
         self._holds[id(res)] = {**self.held, **(hold or {})}

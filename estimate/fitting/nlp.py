@@ -32,6 +32,7 @@ from .covariance import reduced_jacobian
 from .problem import FitProblem
 from .refits import refined
 from .result import FitResult
+from .segment_start import first_part
 from .solution import LOW_R_SQUARED, Solve, fit_result
 from .starts import second_start
 from .strategies import Cost, cost_of
@@ -88,7 +89,7 @@ def fit(problem: FitProblem, *, transcription: Transcription = MultipleShooting(
         progress: bool | None = None, robust_start: bool = True,
         compile_: bool | None = None, warm_start: FitResult | None = None,
         balance: bool = True, unbounded_retry: bool = True, hold_undetermined: bool = True,
-        _free_retry: bool = True) -> FitResult:
+        segment_start: bool = True, _free_retry: bool = True) -> FitResult:
     """Estimate the parameters of ``problem``.
 
     Parameters
@@ -143,6 +144,10 @@ def fit(problem: FitProblem, *, transcription: Transcription = MultipleShooting(
         mass vanished, or its estimates wandered without changing the cost: the fit stops
         then, status ``"Stalled"``), refit with that mode's other parameters held at their
         starts (:mod:`estimate.fitting.vanished`); the note says so.
+    segment_start : bool, default True
+        When the fit of a long record (at least 2,000 samples, no estimated carriage
+        motion) does not converge, fit its first third and then the whole record from
+        those estimates (:mod:`estimate.fitting.segment_start`), kept when both converge.
 
     Returns
     -------
@@ -175,12 +180,38 @@ def fit(problem: FitProblem, *, transcription: Transcription = MultipleShooting(
         problem, result = _better_start(problem, result, *other, lambda p: _solve(
             p, transcription, hessian, cost, kinds, solver_options, progress, compile_, None,
             t_start))
+    part = (first_part(problem) if segment_start and _free_retry and warm_start is None
+            and not result.converged else None)
+    if part is not None:
+        problem, result = _from_first_part(problem, result, *part, lambda p: _solve(
+            p, transcription, hessian, cost, kinds, solver_options, progress, compile_, None,
+            t_start))
     return refined(problem, result, transcription=transcription, hessian=hessian, cost=cost,
                    initial_state=initial_state, solver_options=solver_options,
                    progress=progress, compile_=compile_, warm_start=warm_start,
                    balance=balance, free_retry=_free_retry,
                    unbounded_retry=unbounded_retry, hold_undetermined=hold_undetermined,
                    t_start=t_start)
+
+
+def _from_first_part(problem: FitProblem, result: FitResult, short: FitProblem, what: str,
+                     solve) -> tuple[FitProblem, FitResult]:
+    """``problem`` and ``result`` (a solve that did not converge), or the solve of
+    ``problem`` from the estimates of ``short`` (its cases' first part, ``what``) when
+    both converge, with a note (:mod:`estimate.fitting.segment_start`)."""
+    first = solve(short)
+    if not first.converged:
+        return problem, replace(result, iterations=result.iterations + first.iterations)
+    again = problem.with_initial(dict(zip(first.names, first.values)))
+    second = solve(again)
+    iterations = result.iterations + first.iterations + second.iterations
+    if not second.converged:
+        return problem, replace(result, iterations=iterations)
+    note = (f"the fit from the first stage did not converge ({result.status} after "
+            f"{result.iterations} iterations): fitted {what} first ({first.iterations} "
+            f"iterations), then the whole record from those estimates")
+    again = replace(again, notes=again.notes + (note,))
+    return again, replace(second, problem=again, iterations=iterations)
 
 
 def _better_start(problem: FitProblem, result: FitResult, other: FitProblem, why: str,
