@@ -140,10 +140,10 @@ def fit(problem: FitProblem, *, transcription: Transcription = MultipleShooting(
         can hold the solver in another valley). ``False`` where the start is known to be
         in the right valley (a warm start from a fit that had its own retry).
     hold_undetermined : bool, default True
-        When the fit does not converge because the record does not determine a mode (its
-        mass vanished, or its estimates wandered without changing the cost: the fit stops
-        then, status ``"Stalled"``), refit with that mode's other parameters held at their
-        starts (:mod:`estimate.fitting.vanished`); the note says so.
+        When the fit does not converge because a mode's mass vanished (the record does not
+        show it: the fit stops when its cost stalls then, status ``"Stalled"``), refit
+        with that mode's other parameters held at their starts and its damper at 0
+        (:mod:`estimate.fitting.vanished`); the note says so.
     segment_start : bool, default True
         When the fit of a long record (at least 2,000 samples, no estimated carriage
         motion) does not converge, fit its first third and then the whole record from
@@ -294,6 +294,7 @@ def _solve(problem: FitProblem, transcription: Transcription, hessian: Hessian, 
     w_opt = np.asarray(sol["x"]).ravel()
     # IPOPT may leave a bounded variable a hair outside its bound (its bound_relax_factor)
     theta = np.clip(w_opt[: len(est)] * scales, [e.lower for e in est], [e.upper for e in est])
+    _, Jg = solver.get_function("nlp_jac_g")(w_opt, [])
     nlp.release_buffers()  # the iterates' Jacobians are no longer asked for
     out = nlp.outputs_at(w_opt, cost)
     if not _finite(out) and recorder.last_finite is not None:
@@ -303,7 +304,8 @@ def _solve(problem: FitProblem, transcription: Transcription, hessian: Hessian, 
         theta = np.clip(w_opt[: len(est)] * scales, [e.lower for e in est],
                         [e.upper for e in est])
         out = nlp.outputs_at(w_opt, cost)
-    _, Jg = solver.get_function("nlp_jac_g")(w_opt, [])
+        _, Jg = solver.get_function("nlp_jac_g")(w_opt, [])
+        nlp.release_buffers()
     Je, Jg = scipy_csc(out.jacobian), scipy_csc(Jg)
     Jg = Jg[: Jg.shape[0] - nlp.n_linear]  # the dynamics; the linear bounds are the masses'
     J = reduced_jacobian(Je, Jg, len(est), scales, list(nlp.free_states))

@@ -7,7 +7,6 @@ from __future__ import annotations
 import math
 from collections.abc import Mapping, Sequence
 from dataclasses import dataclass, field, replace
-from pathlib import Path
 
 import numpy as np
 
@@ -289,8 +288,7 @@ class FitProblem:
         bad = [e.name for e in self.estimated if not math.isfinite(e.initial)]
         if bad:
             raise InputError(f"initial values are not finite: {', '.join(bad)}")
-        check_fit([(Path(str(x.case.path)).name if x.case.path else f"case {i}",
-                    int(x.case.time.size), len(self.channels(i)))
+        check_fit([(x.case.path.name, int(x.case.time.size), len(self.channels(i)))
                    for i, x in enumerate(self.experiments)])
 
 

@@ -83,8 +83,7 @@ warm_start, balance
             return replace(inside, iterations=result.iterations + inside.iterations,
                            seconds=time.perf_counter() - t_start)
     if result.status in HELD_STATUSES and free_retry and hold_undetermined:
-        held = held_refit(problem, result.values, result.history, result.status,
-                          result.iterations)
+        held = held_refit(problem, result.values, result.status, result.iterations)
         if held is not None:
             again, note = held
             again = replace(again, notes=again.notes + (note,))
