@@ -13,12 +13,12 @@ __all__ = ["Recorder", "progress_printer"]
 
 class Recorder(ca.Callback):
     """IPOPT iteration callback: records parameter trajectories and prints progress; asks
-    IPOPT to stop (status ``User_Requested_Stop``) when ``stop(costs, thetas)`` says so
-    (the costs ``|r|^2`` and estimates of the iterations so far)."""
+    IPOPT to stop (status ``User_Requested_Stop``) when ``stop(costs, theta)`` says so
+    (the costs ``|r|^2`` of the iterations so far, the current estimates)."""
 
     def __init__(self, nw: int, ng: int, ntheta: int, scales: np.ndarray, cost_scale: float,
                  printer: Callable[[int, float, np.ndarray], None] | None,
-                 stop: Callable[[list[float], list[np.ndarray]], bool] | None = None) -> None:
+                 stop: Callable[[list[float], np.ndarray], bool] | None = None) -> None:
         ca.Callback.__init__(self)
         self.nw, self.ng, self.ntheta = nw, ng, ntheta
         self.scales, self.cost_scale = scales, cost_scale
@@ -62,7 +62,7 @@ class Recorder(ca.Callback):
             self.last_finite = ca.DM(arg[0])  # a copy in C++: converted only when used
         if self.printer is not None:
             self.printer(len(self.costs) - 1, cost, theta)
-        self.stopped = self.stop is not None and self.stop(self.costs, self.thetas)
+        self.stopped = self.stop is not None and self.stop(self.costs, theta)
         return [int(self.stopped)]
 
 

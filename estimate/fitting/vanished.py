@@ -64,22 +64,22 @@ def _vanished(problem: FitProblem, theta: np.ndarray, masses) -> list[int]:
 
 
 def stall_stop(problem: FitProblem, residuals: int
-               ) -> Callable[[Sequence[float], Sequence[np.ndarray]], bool]:
-    """The iteration callback's test to stop IPOPT, from the costs (``|r|^2``) and
-    estimates of the iterations so far: a component's mass has vanished and the cost has
+               ) -> Callable[[Sequence[float], np.ndarray], bool]:
+    """The iteration callback's test to stop IPOPT, from the costs (``|r|^2``) of the
+    iterations so far and the current estimates: a component's mass has vanished and the cost has
     stalled (its least fell by less than one residual variance, ``|r|^2 / residuals``,
     over :data:`STALL_WINDOW` iterations, the current cost within that of the least: a
     change of one in chi-square, below what any parameter the record determines would
     make)."""
     masses = _components(problem)
 
-    def stop(costs: Sequence[float], thetas: Sequence[np.ndarray]) -> bool:
+    def stop(costs: Sequence[float], theta: np.ndarray) -> bool:
         if not masses or len(costs) <= max(STALL_ITERATIONS, STALL_WINDOW):
             return False
         best = min(costs)
         tol = best / max(residuals, 1)
         return (min(costs[:-STALL_WINDOW]) - best < tol and costs[-1] - best < tol
-                and bool(_vanished(problem, thetas[-1], masses)))
+                and bool(_vanished(problem, theta, masses)))
 
     return stop
 

@@ -52,7 +52,7 @@ def test_the_stall_rule(one_mode):
     flat = [6000.0 + 0.01 * (k % 3) for k in range(200)]  # one variance: 1.0
 
     def first_stop(costs, thetas):
-        return next((k for k in range(1, len(costs) + 1) if stop(costs[:k], thetas[:k])), None)
+        return next((k for k in range(1, len(costs) + 1) if stop(costs[:k], thetas[k - 1])), None)
 
     vanished = theta0.copy()
     vanished[names.index("p2.mass")] *= 0.005
