@@ -12,11 +12,14 @@ from typing import TYPE_CHECKING
 import casadi as ca
 import numpy as np
 
+from ._sparse import evaluate
 from .problem import FitProblem
 from .terms import CaseTerms, case_terms
 from .transcription import Transcription
 
 if TYPE_CHECKING:
+    import scipy.sparse as sps
+
     from .nlp import Hessian
     from .result import FitResult
 
@@ -33,8 +36,8 @@ class NlpOutputs:
     e : ndarray
         The residuals the covariance uses (the cost's, or ``simulated - measured`` for the
         ``"abs"`` cost), scaled.
-    jacobian : casadi.DM
-        ``de/dw``, sparse.
+    jacobian : scipy.sparse.csc_matrix
+        ``de/dw`` (structural zeros kept).
     raw, report : ndarray
         ``simulated - measured`` per channel sample (N, N m) and as reports scale it.
     carriage : tuple
@@ -48,7 +51,7 @@ class NlpOutputs:
     """
 
     e: np.ndarray
-    jacobian: ca.DM
+    jacobian: "sps.csc_matrix"
     raw: np.ndarray
     report: np.ndarray
     carriage: tuple
@@ -293,7 +296,8 @@ class AssembledNlp:
         xres = [t.displacement_residual if t.displacement_residual is not None else ca.MX(0, 1)
                 for t in self.terms]
         jac = self.jac_r if same else ca.jacobian(e, self.w)
-        states = [t.block.X for t in self.terms]
+        # the compiled steps' states where there are (the same values: IPOPT's)
+        states = [t.block.X if t.block.X_fast is None else t.block.X_fast for t in self.terms]
         coefs = [t.coef for t in self.terms]
         return ca.Function("residuals", [self.w],
                            [e, jac, raw, report, *extra, *xres, *states, *coefs])
@@ -301,18 +305,25 @@ class AssembledNlp:
     def outputs_at(self, w: np.ndarray, cost: str) -> NlpOutputs:
         """The residuals and per-case quantities at the decision vector ``w``, named
         (:meth:`error_function` gives them in order)."""
-        out = self.error_function(cost)(w)
+        fn = self.error_function(cost)
+        out = evaluate(fn, w)
+        for i, o in enumerate(out):  # an output that is not dense: its zeros are numbers
+            if i != 1 and not isinstance(o, np.ndarray):
+                out[i] = o.toarray()
+        if isinstance(out[1], np.ndarray):  # a Jacobian without structural zeros
+            import scipy.sparse as sps
+
+            out[1] = sps.csc_matrix(out[1])
         terms, k = self.terms, len(self.terms)
         return NlpOutputs(
-            e=np.asarray(out[0]).ravel(), jacobian=out[1],
-            raw=np.asarray(out[2]).ravel(), report=np.asarray(out[3]).ravel(),
-            carriage=tuple(None if terms[i].carriage is None else np.asarray(out[4 + i])
+            e=out[0].ravel(), jacobian=out[1], raw=out[2].ravel(), report=out[3].ravel(),
+            carriage=tuple(None if terms[i].carriage is None else out[4 + i]
                            for i in range(k)),
             displacement_residuals=tuple(
                 None if terms[i].displacement_residual is None
-                else np.asarray(out[4 + k + i]).ravel() for i in range(k)),
-            states=tuple(np.asarray(out[4 + 2 * k + i]) for i in range(k)),
-            coefficients=tuple(np.asarray(out[4 + 3 * k + i]).ravel()
+                else out[4 + k + i].ravel() for i in range(k)),
+            states=tuple(out[4 + 2 * k + i] for i in range(k)),
+            coefficients=tuple(out[4 + 3 * k + i].ravel()
                                if terms[i].coef.numel() else None for i in range(k)))
 
     def initial_states(self, w: np.ndarray) -> tuple[np.ndarray, ...]:

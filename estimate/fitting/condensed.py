@@ -61,14 +61,32 @@ def _sensitivity_symbols(dm: DerivedModel, ntheta: int, width: int):
                              ca.SX.sym("Sc", nx, width))
 
 
-def _step_inputs(nU: int, width: int) -> tuple[list[ca.SX], ca.SX]:
-    """A step's input symbols and its stage inputs: ``[U]`` (data), or ``[B, c]`` with
-    ``U = B c`` (an interval's basis over its window of ``width`` coefficients)."""
+def used_stage_inputs(dm: DerivedModel, substeps: int) -> tuple[int, ...]:
+    """The stage inputs (rows of an RK4 step's ``U``) the step depends on: the lateral
+    rig's pendulums take the carriage's acceleration, not its position and velocity, so
+    two thirds of the stage inputs need no basis (all of them when it depends on none)."""
+    def build() -> tuple[int, ...]:
+        step = rk4_step(dm, substeps)
+        used = tuple(sorted(set(step.sparsity_jac(1, 0).get_col())))
+        return used or tuple(range(step.size1_in(1)))
+
+    return dm.memo(("used_stage_inputs", substeps), build)
+
+
+def _step_inputs(nU: int, width: int, used: tuple[int, ...]
+                 ) -> tuple[list[ca.SX], ca.SX]:
+    """A step's input symbols and its ``nU`` stage inputs: ``[U]`` (data), or ``[B, c]``
+    with ``U[used] = B c`` (an interval's basis over its window of ``width``
+    coefficients, for the ``used`` stage inputs; the others zero)."""
     if not width:
         U = ca.SX.sym("U", nU)
         return [U], U
-    B, c = ca.SX.sym("B", nU, width), ca.SX.sym("c", width)
-    return [B, c], ca.mtimes(B, c)
+    B, c = ca.SX.sym("B", len(used), width), ca.SX.sym("c", width)
+    Bc = ca.mtimes(B, c)
+    U = ca.SX.zeros(nU)
+    for r, i in enumerate(used):
+        U[i] = Bc[r]
+    return [B, c], U
 
 
 def _step(dm: DerivedModel, substeps: int, width: int, compiled: bool) -> ca.Function:
@@ -83,7 +101,7 @@ def _step(dm: DerivedModel, substeps: int, width: int, compiled: bool) -> ca.Fun
     def build() -> ca.Function:
         step = rk4_step(dm, substeps)
         x = ca.SX.sym("x", dm.nx)
-        ins, U = _step_inputs(step.size1_in(1), width)
+        ins, U = _step_inputs(step.size1_in(1), width, used_stage_inputs(dm, substeps))
         p = ca.SX.sym("p", step.size1_in(2))
         t, h = ca.SX.sym("t"), ca.SX.sym("h")
         fn = ca.Function("condensed_step", [x, *ins, p, t, h], [step(x, U, p, t, h)])
@@ -107,7 +125,7 @@ def _propagation(dm: DerivedModel, substeps: int, ntheta: int, width: int,
         step = rk4_step(dm, substeps)
         nx = dm.nx
         x = ca.SX.sym("x", nx)
-        ins, U = _step_inputs(step.size1_in(1), width)
+        ins, U = _step_inputs(step.size1_in(1), width, used_stage_inputs(dm, substeps))
         t, h = ca.SX.sym("t"), ca.SX.sym("h")
         (p0, Sv, th), p, (Sx, St, Sc) = _sensitivity_symbols(dm, ntheta, width)
         xn = step(x, U, p, t, h)
@@ -144,9 +162,10 @@ def condensed_block(dm: DerivedModel, substeps: int, K: int, p: ca.MX, t: np.nda
         # coefficients, inside the step functions (the sparse stage matrix is never made
         # a CasADi constant, nor the inputs an intermediate)
         nU = coefficients.rows
-        key = ("condensed windows", m, nU, K)
+        used = used_stage_inputs(dm, substeps)
+        key = ("condensed windows", m, nU, K, used)
         if key not in coefficients.cache:
-            coefficients.cache[key] = _Windows.of(coefficients.stage, m, nU, K)
+            coefficients.cache[key] = _Windows.of(coefficients.stage, m, nU, K, used)
         win = coefficients.cache[key]
         if win.width > WINDOW_MAX:
             return None  # inputs not local in their coefficients: a node per sample instead
@@ -295,38 +314,50 @@ class _Windows:
         return dm.mapped(key, fn, m)(basis, Cw)
 
     @classmethod
-    def of(cls, A, m: int, nU: int, K: int) -> "_Windows":
+    def of(cls, A, m: int, nU: int, K: int, used: tuple[int, ...] | None = None
+           ) -> "_Windows":
         """Windows of the ``m`` intervals of ``K`` steps of ``nU`` stage inputs each,
         ``vec(U) = A c`` (``A`` CasADi or SciPy; its rows past its end: the padded steps,
-        zero)."""
+        zero), with bases for the ``used`` stage inputs (default all)."""
+        used = tuple(range(nU)) if used is None else tuple(used)
         C, row = _rows(A)
         nc, per = C.shape[1], nU * K  # stage-input rows per interval
+        # keep the rows of the used stage inputs: row r = k per + j nU + i
+        position = np.full(nU, -1, dtype=np.int64)
+        position[list(used)] = np.arange(len(used))
+        pos = position[row % nU]
+        if len(used) < nU:
+            keep = pos >= 0
+            C = C[np.flatnonzero(np.isin(np.arange(C.shape[0]) % nU, used))]
+            row, pos = row[keep], pos[keep]
+        nu_ = len(used)
         lo = np.zeros(m, dtype=np.int64)
         hi = np.zeros(m, dtype=np.int64)
         # each row's first and last column (sorted within rows), then each interval's
         full = np.flatnonzero(np.diff(C.indptr))
         if full.size:
-            k = full // per
+            k = row[C.indptr[full]] // per
             present, first = np.unique(k, return_index=True)  # rows ascending: k sorted
             lo[present] = np.minimum.reduceat(C.indices[C.indptr[full]], first)
             hi[present] = np.maximum.reduceat(C.indices[C.indptr[full + 1] - 1], first)
         # a multiple of 4: fewer distinct compiled functions over records (zero columns)
         width = int(min(nc, -(-int((hi - lo).max() + 1) // 4) * 4))
         start = np.clip(lo, 0, nc - width)
-        # per step j: the (nU x width) bases of every interval side by side; entry of row
-        # r = k per + w (w = j nU + i) and column c at ((w m + k) width + c - start[k])
+        # per step j: the (nu_ x width) bases of every interval side by side; entry of
+        # row r = k per + j nU + i (used stage input i at position pos) and column c at
+        # (((j nu_ + pos) m + k) width + c - start[k])
         k = row // per
-        flat = row - k * per
+        flat = (row - k * per) // nU * nu_ + pos
         flat *= m
         flat += k
         flat *= width
         flat += C.indices
         flat -= start[k]
-        L = np.zeros((K, nU, m, width))
+        L = np.zeros((K, nu_, m, width))
         L.ravel()[flat] = C.data
         # MX constants: the block passes them to three mapped runs (simulation, compiled
         # simulation, sensitivities), and a DM argument would be copied into each
-        basis = [ca.MX(dense_dm(L[j].reshape(nU, m * width))) for j in range(K)]
+        basis = [ca.MX(dense_dm(L[j].reshape(nu_, m * width))) for j in range(K)]
         return cls(start, width, lo - start, hi - start, basis, nc)
 
     def grid_bases(self, A_grid, nu: int, K: int, n: int) -> tuple[ca.MX, ca.DM]:

@@ -20,13 +20,14 @@ from dataclasses import dataclass, replace
 
 import casadi as ca
 import numpy as np
+import scipy.sparse as sps
 
 from analogs.errors import InputError
 
 from ..data.case import KNOWN_INITIAL_STATES
 from ..interrupts import surfacing
 from ._progress import Recorder, progress_printer
-from ._sparse import scipy_csc
+from ._sparse import evaluate
 from .assembly import assemble_nlp
 from .covariance import reduced_jacobian
 from .problem import FitProblem
@@ -244,7 +245,13 @@ WIDE_KNOT_SAMPLES = 25
 
 def _finite(out) -> bool:
     """Whether the residuals and their Jacobian at a solution are numbers."""
-    return bool(np.all(np.isfinite(out.e)) and np.all(np.isfinite(out.jacobian.nonzeros())))
+    return bool(np.all(np.isfinite(out.e)) and np.all(np.isfinite(out.jacobian.data)))
+
+
+def _constraint_jacobian(solver: ca.Function, w: np.ndarray):
+    """The constraint Jacobian IPOPT used, at ``w``, as a SciPy CSC matrix."""
+    Jg = evaluate(solver.get_function("nlp_jac_g"), w, np.zeros(0))[1]
+    return Jg if not isinstance(Jg, np.ndarray) else sps.csc_matrix(Jg)
 
 
 def pivot_order(problem: FitProblem) -> int:
@@ -294,7 +301,7 @@ def _solve(problem: FitProblem, transcription: Transcription, hessian: Hessian, 
     w_opt = np.asarray(sol["x"]).ravel()
     # IPOPT may leave a bounded variable a hair outside its bound (its bound_relax_factor)
     theta = np.clip(w_opt[: len(est)] * scales, [e.lower for e in est], [e.upper for e in est])
-    _, Jg = solver.get_function("nlp_jac_g")(w_opt, [])
+    Jg = _constraint_jacobian(solver, w_opt)
     nlp.release_buffers()  # the iterates' Jacobians are no longer asked for
     out = nlp.outputs_at(w_opt, cost)
     if not _finite(out) and recorder.last_finite is not None:
@@ -304,9 +311,9 @@ def _solve(problem: FitProblem, transcription: Transcription, hessian: Hessian, 
         theta = np.clip(w_opt[: len(est)] * scales, [e.lower for e in est],
                         [e.upper for e in est])
         out = nlp.outputs_at(w_opt, cost)
-        _, Jg = solver.get_function("nlp_jac_g")(w_opt, [])
+        Jg = _constraint_jacobian(solver, w_opt)
         nlp.release_buffers()
-    Je, Jg = scipy_csc(out.jacobian), scipy_csc(Jg)
+    Je = out.jacobian
     Jg = Jg[: Jg.shape[0] - nlp.n_linear]  # the dynamics; the linear bounds are the masses'
     J = reduced_jacobian(Je, Jg, len(est), scales, list(nlp.free_states))
     initial_states = tuple(
