@@ -162,15 +162,39 @@ class CarriageInput:
                                           for d in range(order + 1))
         return self._shift_memo[key]
 
-    def derivative_designs(self, times: np.ndarray, order: int) -> tuple:
-        """:meth:`taylor_designs` as sparse CasADi matrices. Kept with this object."""
-        from ._sparse import sparse_dm
+    def shift_design(self, times: np.ndarray, order: int) -> tuple:
+        """:meth:`taylor_designs` on one sparsity (their union) as ``(pattern, V)``: column
+        ``d`` of the dense ``nnz x (order + 1)`` matrix ``V`` (a CasADi DM) holds design
+        ``d``'s values on the pattern's nonzeros, so the shifted design
+        ``sum_d lag^d D_d`` has the nonzeros ``V [1, lag, ..., lag^order]``: one product
+        where the sparse matrices took ``2 order`` (and converting them took twice as
+        long). Kept with this object."""
+        import casadi as ca
+
+        from ._sparse import dense_dm
 
         t = np.asarray(times, float)
-        key = ("casadi", t.tobytes(), order)
+        key = ("shift", t.tobytes(), order)
         if key not in self._shift_memo:
-            designs = self.taylor_designs(t, order)
-            self._shift_memo[key] = tuple(sparse_dm(D) for D in designs)
+            designs = [sps.csc_matrix(D) for D in self.taylor_designs(t, order)]
+            rows, cols = designs[0].shape
+            ones = [sps.csc_matrix((np.ones(D.nnz), D.indices, D.indptr), D.shape)
+                    for D in designs]
+            union = sum(ones[1:], ones[0])  # the patterns' union (no entry cancels)
+            union.sort_indices()
+
+            def keys(D):  # column-major positions, ascending (sorted CSC)
+                return np.repeat(np.arange(cols, dtype=np.int64) * rows,
+                                 np.diff(D.indptr)) + D.indices
+
+            where = keys(union)
+            V = np.zeros((where.size, len(designs)))
+            for d, D in enumerate(designs):
+                D.sum_duplicates()
+                V[np.searchsorted(where, keys(D)), d] = D.data
+            pattern = ca.Sparsity(rows, cols, memoryview(union.indptr.astype(np.int64)),
+                                  memoryview(union.indices.astype(np.int64)))
+            self._shift_memo[key] = (pattern, dense_dm(V))
         return self._shift_memo[key]
 
     @property

@@ -442,10 +442,11 @@ class StepSensitivities:
 
 def _output_sensitivity(dm: DerivedModel, channels: tuple[str, ...], ntheta: int,
                         width: int, compiled: bool) -> ca.Function:
-    """``(x, u, Bg, p0, vec(S), theta, t, Sx, St, Sc) -> (dy/dnode, dy/dtheta, dy/dc)`` of
-    the measured outputs ``y(x, u, p, t)`` (one row per channel) at a state with
-    sensitivities ``Sx, St, Sc`` and grid inputs ``u = Bg c`` over the window."""
-    key = ("condensed_output", channels, ntheta, width, compiled)
+    """``(x, u, Bg, p0, vec(S), theta, t, Sx, St, Sc, w) -> (dy/dnode, dy/dtheta, dy/dc)``
+    of the measured outputs ``y(x, u, p, t)`` (one row per channel) at a state with
+    sensitivities ``Sx, St, Sc`` and grid inputs ``u = Bg c`` over the window, row ``i``
+    times ``w[i]`` (the residual's factor: no scaling of the mapped outputs after)."""
+    key = ("condensed_output", channels, ntheta, width, compiled, "weighted")
 
     def build() -> ca.Function:
         from derive import OUTPUT_NAMES
@@ -458,10 +459,12 @@ def _output_sensitivity(dm: DerivedModel, channels: tuple[str, ...], ntheta: int
         out = dm.outputs(x, u, p, t)
         y = ca.vertcat(*[out[OUTPUT_NAMES.index(c)] for c in channels])
         Hx = ca.jacobian(y, x)
-        outs = [ca.densify(ca.mtimes(Hx, Sx)), ca.densify(ca.mtimes(Hx, St) + ca.jacobian(y, th)),
-                ca.densify(ca.mtimes(Hx, Sc) + ca.jtimes(y, u, Bg)) if width
+        w = ca.SX.sym("w", len(channels))
+        outs = [ca.mtimes(Hx, Sx), ca.mtimes(Hx, St) + ca.jacobian(y, th),
+                ca.mtimes(Hx, Sc) + ca.jtimes(y, u, Bg) if width
                 else ca.SX(len(channels), 0)]
-        fn = ca.Function("condensed_output", [x, u, Bg, p0, Sv, th, t, Sx, St, Sc], outs)
+        outs = [ca.densify(o * ca.repmat(w, 1, o.size2())) for o in outs]
+        fn = ca.Function("condensed_output", [x, u, Bg, p0, Sv, th, t, Sx, St, Sc, w], outs)
         if compiled:
             fn = compile_fn(fn)
         return fn
@@ -493,16 +496,21 @@ def residual_jacobian(dm: DerivedModel, channels: tuple[str, ...], sens: StepSen
         raise ValueError("the condensed block of an estimated input made no grid bases "
                          "(InputCoefficients.grid missing)")
     bases = None if win is None else win.grid  # all steps' (nu K x width m), sample 0's
+    # the residual's factors by channel (rows) and sample (columns), the padded samples 0
+    factor = np.asarray(factor, float)
+    weights = np.zeros((nch, m * K + 1))
+    weights[:, :n] = factor.reshape(nch, n)
     outs = []
     for j in range(K):
         Bg = ca.DM(nu, 0) if win is None else bases[0][j * nu:(j + 1) * nu, :]
         outs.append(fmap(sens.states[j], Ugp[:, j + 1::K], Bg, p0, ca.vec(S), theta,
-                         ca.DM(tp[j + 1::K]).T, sens.Sx[j], sens.St[j], sens.Sc[j]))
+                         ca.DM(tp[j + 1::K]).T, sens.Sx[j], sens.St[j], sens.Sc[j],
+                         dense_dm(weights[:, j + 1::K])))
     # sample 0: at node 0, whose sensitivities are the identity and zeros
     Bg0 = ca.DM(nu, 0) if win is None else bases[1]
     outs.append(fn(sens.N[:, 0], Ug[:, 0], Bg0, p0, ca.vec(S), theta, float(t[0]),
-                   ca.DM.eye(nx), ca.DM.zeros(nx, ntheta), ca.DM.zeros(nx, width)))
-    factor = np.asarray(factor, float)
+                   ca.DM.eye(nx), ca.DM.zeros(nx, ntheta), ca.DM.zeros(nx, width),
+                   dense_dm(weights[:, 0])))
     # sample s = k K + j + 1 of step j, interval k (padded samples s >= n dropped); the
     # last entry of every block list is sample 0's (interval 0, "step -1")
 
@@ -521,10 +529,7 @@ def residual_jacobian(dm: DerivedModel, channels: tuple[str, ...], sens: StepSen
             src.append((off + (k_ * width_b + c_) * nch + ch_)[keep])
             off += count * width_b * nch
         rows, cols, src = np.concatenate(rows), np.concatenate(cols), np.concatenate(src)
-        values = ca.vertcat(*[ca.vec(o[idx]) for o in outs])
-        scale = np.zeros(off)
-        scale[src] = factor[rows]
-        return rows, cols, src, values * ca.DM(scale)
+        return rows, cols, src, ca.vertcat(*[ca.vec(o[idx]) for o in outs])
 
     rows, cols, src, v = block(1, ntheta, lambda k_, c_: columns[c_])
     J_theta = scatter(v, (nch * n, ntheta_all), rows, cols, src)

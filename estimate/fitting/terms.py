@@ -223,8 +223,9 @@ def case_terms(problem: FitProblem, i: int, theta_s: ca.MX, transcription: Trans
         if lag is None:
             shifted = carriage.casadi_matrix(t, transcription.fractions(), "displacement")
         else:  # the recorded displacement is the spline `lag` later: its Taylor series
-            designs = carriage.derivative_designs(t, lag[2].order)
-            shifted = sum((lag[0] ** d * designs[d] for d in range(1, len(designs))), designs[0])
+            pattern, V = carriage.shift_design(t, lag[2].order)
+            powers = ca.vertcat(1, *[lag[0] ** d for d in range(1, V.size2())])
+            shifted = ca.MX(pattern, ca.mtimes(V, powers))
         x_resid = ca.mtimes(shifted, coef) - ca.DM(carriage.displacement)
         ex = x_resid / carriage.displacement_noise
         e = ca.vertcat(e, ex)
@@ -262,9 +263,9 @@ def case_terms(problem: FitProblem, i: int, theta_s: ca.MX, transcription: Trans
             jt_x = ca.MX(nd, jt.size2())
             if lag is not None:  # d x_rec / d lag: the shifted spline's velocity
                 tau, j, mm = lag
-                designs = carriage.derivative_designs(t, mm.order)
-                velocity = sum((d * tau ** (d - 1) * designs[d] for d in range(2, len(designs))),
-                               designs[1])
+                pattern, V = carriage.shift_design(t, mm.order)
+                rates = ca.vertcat(0, 1, *[d * tau ** (d - 1) for d in range(2, V.size2())])
+                velocity = ca.MX(pattern, ca.mtimes(V, rates))
                 scale_j = problem.estimated[j].scale
                 jt_x = ca.horzcat(ca.MX(nd, j), ca.mtimes(velocity, coef) * (scale_j / sx),
                                   ca.MX(nd, jt.size2() - j - 1))
