@@ -164,8 +164,8 @@ class CarriageInput:
 
     def shift_design(self, times: np.ndarray, order: int) -> tuple:
         """:meth:`taylor_designs` on one sparsity (their union) as ``(pattern, V)``: column
-        ``d`` of the dense ``nnz x (order + 1)`` matrix ``V`` (a CasADi DM) holds design
-        ``d``'s values on the pattern's nonzeros, so the shifted design
+        ``d`` of the dense ``nnz x (order + 1)`` matrix ``V`` (a CasADi MX constant) holds
+        design ``d``'s values on the pattern's nonzeros, so the shifted design
         ``sum_d lag^d D_d`` has the nonzeros ``V [1, lag, ..., lag^order]``: one product
         where the sparse matrices took ``2 order`` (and converting them took twice as
         long). Kept with this object."""
@@ -194,7 +194,8 @@ class CarriageInput:
                 V[np.searchsorted(where, keys(D)), d] = D.data
             pattern = ca.Sparsity(rows, cols, memoryview(union.indptr.astype(np.int64)),
                                   memoryview(union.indices.astype(np.int64)))
-            self._shift_memo[key] = (pattern, dense_dm(V))
+            # an MX constant: the shifted design and its velocity share one copy
+            self._shift_memo[key] = (pattern, ca.MX(dense_dm(V)))
         return self._shift_memo[key]
 
     @property
