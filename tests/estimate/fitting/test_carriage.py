@@ -79,3 +79,30 @@ def test_casadi_matrices_are_the_design_matrices(carriage, fractions):
         got = dm.sparse()
         assert got.shape == ref.shape
         assert abs(got - ref).max() <= 1e-12 * abs(ref).max()
+
+
+def test_shift_design_is_the_taylor_series_of_the_lagged_spline(carriage):
+    """The lagged displacement's design held as one dense matrix on its pattern
+    (:meth:`CarriageInput.shift_design`): its nonzeros times ``[1, lag, ..., lag^5]`` are
+    the SciPy sum ``sum_d lag^d D_d`` of the spline's Taylor designs (round-off), and
+    times the coefficients they give SciPy's B-spline ``lag`` later to the series'
+    remainder (exact inside a knot span, 1e-4 of the motion where the lag crosses a knot:
+    bounded here by 1e-3)."""
+    import casadi as ca
+    import scipy.sparse as sps
+    from scipy.interpolate import BSpline
+
+    t, ci = carriage
+    lag = 0.02
+    pattern, V = ci.shift_design(t, 5)
+    nz = np.asarray(ca.evalf(ca.mtimes(V, ca.DM([lag ** d for d in range(6)])))).ravel()
+    shifted = sps.csc_matrix((nz, np.array(pattern.row()), np.array(pattern.colind())),
+                             shape=(pattern.size1(), pattern.size2()))
+    reference = sum(lag ** d * D for d, D in enumerate(ci.taylor_designs(t, 5)))
+    assert abs(shifted - reference).max() <= 1e-12 * abs(reference).max()
+    c = ci.coefficients
+    spline = BSpline(ci.spline.knots, c if ci.basis is None else ci.basis @ c,
+                     ci.spline.degree)
+    inside = (t + lag) <= t[-1]
+    x = spline(t[inside] + lag)
+    assert np.max(np.abs((shifted @ c)[inside] - x)) <= 1e-3 * np.max(np.abs(x))

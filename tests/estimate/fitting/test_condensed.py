@@ -78,3 +78,29 @@ def test_condensed_carriage_inputs_are_the_spline_without_its_stage_matrix(tmp_p
     span = np.ptp(spline, axis=1, keepdims=True)
     assert np.max(np.abs(got - spline) / span) < 1e-9
     assert "stage" not in made and "displacement" in made
+
+
+def test_window_bases_only_for_the_stage_inputs_the_step_depends_on(tmp_path):
+    """The lateral rig's pendulum takes the carriage acceleration, not its position or
+    velocity: of the step's stage inputs ``[x, xd, xdd]`` at RK4's three stage times only
+    the accelerations (rows 2, 5, 8) are used. Checked numerically: the step's result
+    does not move when the other rows change, and moves when an acceleration does."""
+    from derive import rk4_step
+    from estimate.fitting.condensed import used_stage_inputs
+
+    case, _ = make_case(tmp_path, "c", ref.Ramped(ref.Sine(0.003, 2.1), 1.0, 0.0),
+                        pendulums=[pendulum()], duration=2.0, rate=200.0, seed=7)
+    problem = FitProblem.build(case, model_from_spec("fixed,p1", case))
+    dm = problem.experiments[0].derived
+    assert used_stage_inputs(dm, 1) == (2, 5, 8)
+    step = rk4_step(dm, 1)
+    rng = np.random.default_rng(3)
+    x = np.array([0.1, -0.3])
+    p = dm.parameter_vector(problem.case_values(0, problem.initial))
+    U = rng.normal(size=9)
+    base = np.asarray(step(x, U, p, 0.0, 0.005)).ravel()
+    for i in range(9):
+        V = U.copy()
+        V[i] += 1.0
+        moved = np.abs(np.asarray(step(x, V, p, 0.0, 0.005)).ravel() - base).max()
+        assert (moved > 1e-9) == (i in (2, 5, 8)), (i, moved)
