@@ -93,7 +93,7 @@ def main() -> None:
             continue
         # the case reader refuses a record over the memory budget (4 GiB by default:
         # 262,144 samples); the long rows are here to be measured, so the budget is raised
-        # to what the reader asks for them (the 600,001-sample row peaks at about 5.5 GB)
+        # to what the reader asks for them (the 600,001-sample row peaks at about 4.9 GB)
         env = dict(os.environ)
         env.setdefault(BUDGET_VARIABLE, str(max(DEFAULT_BUDGET,
                                                 int(duration * rate + 1) * FIT_BYTES_PER_SAMPLE)))
