@@ -57,11 +57,12 @@ def affine_parameters(p: ca.MX, theta: ca.MX) -> tuple[ca.DM, ca.DM]:
     return p0, S
 
 
-def evaluate(fn: ca.Function, *args) -> list:
-    """``fn(*args)`` with NumPy results: a dense output as an array of its shape, a sparse
-    one as a SciPy CSC matrix (structural zeros kept). The outputs are written straight
-    into NumPy arrays (a function buffer): converting a 30,001-sample fit's DM residual
-    Jacobian to SciPy, and reading its nonzeros to check them, took 0.3 s."""
+def evaluate(fn: ca.Function, *args, sparse: tuple[int, ...] = ()) -> list:
+    """``fn(*args)`` with NumPy results: the outputs numbered in ``sparse`` as SciPy CSC
+    matrices (structural zeros kept), the others as dense arrays of their shapes. The
+    outputs are written straight into NumPy arrays (a function buffer): converting a
+    30,001-sample fit's DM residual Jacobian to SciPy, and reading its nonzeros to check
+    them, took 0.3 s."""
     buf, trigger = fn.buffer()
     ins = [np.ascontiguousarray(np.asarray(a, float).ravel(order="F")) for a in args]
     for i, a in enumerate(ins):
@@ -76,10 +77,13 @@ def evaluate(fn: ca.Function, *args) -> list:
     result = []
     for i, o in enumerate(outs):
         sp = fn.sparsity_out(i)
-        if sp.is_dense():
+        M = sps.csc_matrix((o, np.array(sp.row(), np.int64), np.array(sp.colind(), np.int64)),
+                           shape=(sp.size1(), sp.size2())) if i in sparse or not sp.is_dense() \
+            else None
+        if i in sparse:
+            result.append(M)
+        elif M is None:
             result.append(o.reshape(sp.size1(), sp.size2(), order="F"))
         else:
-            result.append(sps.csc_matrix((o, np.array(sp.row(), np.int64),
-                                          np.array(sp.colind(), np.int64)),
-                                         shape=(sp.size1(), sp.size2())))
+            result.append(M.toarray())
     return result

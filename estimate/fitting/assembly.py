@@ -305,15 +305,7 @@ class AssembledNlp:
     def outputs_at(self, w: np.ndarray, cost: str) -> NlpOutputs:
         """The residuals and per-case quantities at the decision vector ``w``, named
         (:meth:`error_function` gives them in order)."""
-        fn = self.error_function(cost)
-        out = evaluate(fn, w)
-        for i, o in enumerate(out):  # an output that is not dense: its zeros are numbers
-            if i != 1 and not isinstance(o, np.ndarray):
-                out[i] = o.toarray()
-        if isinstance(out[1], np.ndarray):  # a Jacobian without structural zeros
-            import scipy.sparse as sps
-
-            out[1] = sps.csc_matrix(out[1])
+        out = evaluate(self.error_function(cost), w, sparse=(1,))
         terms, k = self.terms, len(self.terms)
         return NlpOutputs(
             e=out[0].ravel(), jacobian=out[1], raw=out[2].ravel(), report=out[3].ravel(),

@@ -177,6 +177,8 @@ class CarriageInput:
         key = ("shift", t.tobytes(), order)
         if key not in self._shift_memo:
             designs = [sps.csc_matrix(D) for D in self.taylor_designs(t, order)]
+            for D in designs:  # converted copies: the kept designs stay as they are
+                D.sum_duplicates()
             rows, cols = designs[0].shape
             ones = [sps.csc_matrix((np.ones(D.nnz), D.indices, D.indptr), D.shape)
                     for D in designs]
@@ -190,7 +192,6 @@ class CarriageInput:
             where = keys(union)
             V = np.zeros((where.size, len(designs)))
             for d, D in enumerate(designs):
-                D.sum_duplicates()
                 V[np.searchsorted(where, keys(D)), d] = D.data
             pattern = ca.Sparsity(rows, cols, memoryview(union.indptr.astype(np.int64)),
                                   memoryview(union.indices.astype(np.int64)))

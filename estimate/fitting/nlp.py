@@ -20,7 +20,6 @@ from dataclasses import dataclass, replace
 
 import casadi as ca
 import numpy as np
-import scipy.sparse as sps
 
 from analogs.errors import InputError
 
@@ -250,8 +249,7 @@ def _finite(out) -> bool:
 
 def _constraint_jacobian(solver: ca.Function, w: np.ndarray):
     """The constraint Jacobian IPOPT used, at ``w``, as a SciPy CSC matrix."""
-    Jg = evaluate(solver.get_function("nlp_jac_g"), w, np.zeros(0))[1]
-    return Jg if not isinstance(Jg, np.ndarray) else sps.csc_matrix(Jg)
+    return evaluate(solver.get_function("nlp_jac_g"), w, np.zeros(0), sparse=(1,))[1]
 
 
 def pivot_order(problem: FitProblem) -> int:
