@@ -19,7 +19,10 @@ Andrews' 1991 bandwidth) long-run covariance of the measured channels' scores gi
 lag-0 covariance, never below 1. The plain Newey-West middle is not used because the estimated
 carriage motion (hundreds of nuisance coefficients) takes a share of the residuals that it
 reads as precision: 0.67 times the Gauss-Newton standard error of the pendulum length on the
-bundled example, whose residuals are white.
+bundled example, whose residuals are white. Nor can residuals show the noise the estimated
+carriage motion absorbed inside its band, where a sine record's information is: no
+parameter's variance is left below that of the sandwich on the channels' noise spectra
+(:mod:`estimate.fitting.spectral_sandwich`).
 
 The residual sensitivity to the parameters alone (states follow through the constraints,
 nuisance variables held) is kept for the identifiability check and the diagnosis.
@@ -35,6 +38,7 @@ import scipy.sparse.linalg as spla
 
 from .identifiability import Identifiability, analyse
 from .kkt import factorise
+from .spectral_sandwich import spectral_middle
 
 __all__ = ["Uncertainty", "reduced_jacobian", "robust_covariance", "uncertainty"]
 
@@ -156,15 +160,16 @@ def uncertainty(jac_residuals: sps.spmatrix, jac_constraints: sps.spmatrix,
         Xs = np.zeros((ntheta, ntheta))  # held parameters: zero rows and columns
         Xs[np.ix_(free, free)] = X
         robust, lags = robust_covariance(Xs, kkt.effective_jacobian(), residuals, samples,
-                                         n_observations / max(n_observations - k, 1))
+                                         n_observations / max(n_observations - k, 1),
+                                         step=lambda w: kkt.Je @ kkt.step(w))
         robust = robust * np.outer(scales, scales)
     return Uncertainty(cov, d, corr, sigma2, ident, tuple(warnings), bound_se, robust, lags,
                        reach)
 
 
 def robust_covariance(information_inverse: np.ndarray, effective_jacobian: np.ndarray,
-                      residuals: np.ndarray, samples: list[np.ndarray], dof_factor: float = 1.0
-                      ) -> tuple[np.ndarray, tuple[int, ...]]:
+                      residuals: np.ndarray, samples: list[np.ndarray], dof_factor: float = 1.0,
+                      step=None) -> tuple[np.ndarray, tuple[int, ...]]:
     """The covariance of the (scaled) parameters robust to heteroscedastic and autocorrelated
     residuals, and the Newey-West bandwidth of each case.
 
@@ -180,7 +185,12 @@ def robust_covariance(information_inverse: np.ndarray, effective_jacobian: np.nd
     their sandwich: the ratio of its Newey-West long-run middle (Bartlett kernel, Andrews'
     bandwidth) to its lag-0 middle, never below 1 (the estimated carriage motion takes part
     of the residual, which leaves the scores slightly anticorrelated without making the
-    estimates any better)."""
+    estimates any better).
+
+    With ``step`` (the change of the residuals by the Gauss-Newton step from residuals
+    ``w``), no parameter's variance is left below that of the sandwich on the channels'
+    noise spectra (:mod:`estimate.fitting.spectral_sandwich`): the residuals do not hold the
+    noise the estimated carriage motion absorbed, in the band where the information is."""
     J, e = effective_jacobian, residuals
     X = information_inverse
     lag0_all = (J * e[:, None] ** 2).T @ J
@@ -188,7 +198,14 @@ def robust_covariance(information_inverse: np.ndarray, effective_jacobian: np.nd
     with np.errstate(invalid="ignore", divide="ignore"):
         ratio = np.diag(X @ long_run @ X) / np.diag(X @ lag0 @ X)
     widen = np.sqrt(np.where(np.isfinite(ratio), np.maximum(ratio, 1.0), 1.0))
-    return dof_factor * (X @ lag0_all @ X) * np.outer(widen, widen), lags
+    cov = dof_factor * (X @ lag0_all @ X) * np.outer(widen, widen)
+    if step is not None:
+        spectral = np.diag(X @ spectral_middle(J, e, samples, step) @ X)
+        with np.errstate(invalid="ignore", divide="ignore"):
+            r = spectral / np.diag(cov)
+        more = np.sqrt(np.where(np.isfinite(r), np.maximum(r, 1.0), 1.0))
+        cov = cov * np.outer(more, more)
+    return cov, lags
 
 
 def _long_run_scores(J: np.ndarray, e: np.ndarray, samples: list[np.ndarray]
