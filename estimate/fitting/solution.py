@@ -14,6 +14,7 @@ import scipy.sparse as sps
 from ._progress import Recorder
 from .assembly import NlpOutputs
 from .covariance import uncertainty
+from .mode_conflicts import mode_conflicts
 from .noise_figures import case_figures, model_error_factor
 from .problem import FitProblem
 from .result import FitResult, derived_quantities, reach_sides
@@ -174,6 +175,8 @@ def fit_result(problem: FitProblem, solve: Solve) -> FitResult:
         away, np.ones(unc.bound_reach.shape[1] - away.size)][None, :]
     bound_stderr = None if unc.bound_stderr is None else widen * unc.bound_stderr
     derived, derived_units, derived_reach = derived_quantities(problem, theta, cov, held, reach)
+    warnings += mode_conflicts(problem, theta, stderr, cov,
+                               {k: v[0] for k, v in derived.items()})
     return FitResult(
         problem=problem,
         values=theta, stderr=stderr, covariance=cov,

@@ -7,9 +7,9 @@ fraction of the noise (a 60 s, 500 Hz record from a transducer with coloured noi
 1e-1 of it between 1.7 and 5.4 Hz). That band is where the slosh parameters' information
 lives, so any middle read from the residuals (lag-0 or Newey-West) understates the spread of
 the estimates: on 41 such records driven by a sine, the masses' 95 % intervals covered the
-truth 32-33 times (z-scores' spread 1.48). The noise itself is not absorbed; the estimates move with it as
-``X J^T n`` (``J`` the residuals' sensitivity with the nuisance re-estimated, ``X`` the
-inverse information), whose variance needs the noise spectrum ``S(f)``:
+truth 32-33 times (z-scores' spread 1.48). The noise is still in the estimates, which move
+with it as ``X J^T n`` (``J`` the residuals' sensitivity with the nuisance re-estimated,
+``X`` the inverse information); their variance needs the noise spectrum ``S(f)``:
 ``Omega = sum_k J_k^H S_k J_k / N`` over the discrete Fourier transform of ``J``'s rows.
 
 ``S`` is read from the residuals' spectrum divided by the fit's own transfer of white noise:
