@@ -140,7 +140,8 @@ class ResultIntervals:
         worse = self.optimistic()
         widened = (f" widened {self.model_error:.3g}x for model error (the residual over its "
                    "noise figure);" if self.model_error > 1 else "")
-        return ("Standard errors: the covariance robust to correlated residuals (Newey-West);"
+        return ("Standard errors: the covariance robust to correlated residuals (Newey-West, "
+                "no lower than the channels' noise spectra give);"
                 + widened + " "
                 + ("the Gauss-Newton ones, which assume independent residuals, are optimistic: "
                    + ", ".join(f"{r:.2g}x smaller for `{n}`" for n, r in worse.items()) + "."
