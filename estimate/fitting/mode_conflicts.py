@@ -41,6 +41,7 @@ def mode_conflicts(problem, theta: np.ndarray, stderr: np.ndarray, cov: np.ndarr
         return []
     g = case.rig.gravity
     names = [e.name for e in problem.estimated]
+    d = np.sqrt(np.clip(np.diag(cov), 0, None))
     out = []
     for i, e in enumerate(problem.estimated):
         comp, local = e.parameter.split(".", 1) if "." in e.parameter else ("", "")
@@ -50,11 +51,10 @@ def mode_conflicts(problem, theta: np.ndarray, stderr: np.ndarray, cov: np.ndarr
         if not m_pred or not L_pred or m_pred <= 0:
             continue
         m, se = float(theta[i]), float(stderr[i])
-        if not (m - 2 * se > PREDICTION_FACTOR * m_pred if math.isfinite(se) else False):
+        if not (math.isfinite(se) and m - 2 * se > PREDICTION_FACTOR * m_pred):
             continue
         f_pred = math.sqrt(g / L_pred) / (2 * math.pi)
         f_fit = derived.get(f"{comp}.frequency_hz", math.nan)
-        d = np.sqrt(np.clip(np.diag(cov), 0, None))
         with np.errstate(invalid="ignore", divide="ignore"):
             corr = cov[i] / (d[i] * d)
         movers = [(names[j], corr[j]) for j in np.argsort(-np.abs(np.nan_to_num(corr)))

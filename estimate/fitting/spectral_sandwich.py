@@ -26,6 +26,7 @@ from __future__ import annotations
 
 import numpy as np
 from scipy import optimize, signal
+from scipy.ndimage import median_filter
 
 __all__ = ["G_MIN", "spectral_middle"]
 
@@ -132,23 +133,22 @@ def _noise_model(f: np.ndarray, S: np.ndarray, top: float, dof: float):
     Lines (estimates 4 robust deviations above a running median) are left out. The log of a
     Welch estimate with ``dof`` degrees of freedom is low by about ``1 / dof`` on average,
     which is put back."""
-    x = f / top
     y = np.log(np.maximum(S, 1e-300))
-    k = min(7, y.size // 2 * 2 - 1)
-    padded = np.pad(y, k // 2, mode="edge")
-    med = np.median(np.lib.stride_tricks.sliding_window_view(padded, k), axis=1)
-    spread = 1.4826 * np.median(np.abs(y - med)) + 1e-12
-    keep = y - med < 4 * spread
-    x, y = x[keep], y[keep]
+    med = median_filter(y, size=min(7, y.size // 2 * 2 - 1), mode="nearest")
+    keep = y - med < 4 * (1.4826 * np.median(np.abs(y - med)) + 1e-12)
+    lx, y = np.log(f[keep] / top), y[keep]
     white = float(np.mean(y))
+
+    def flat(ff):
+        return np.full(np.shape(ff), np.exp(white + 1.0 / dof))
+
     ssr_white = float(np.sum((y - white) ** 2))
-    lx = np.log(x)
     n = y.size
     # no slope in log-log at 5 %: white, without the power law's fit
     slope = np.polyfit(lx, y, 1, full=True)[1]
     ssr_slope = float(slope[0]) if slope.size else ssr_white
     if n <= 6 or (ssr_white - ssr_slope) < 3.84 * ssr_slope / (n - 2):
-        return lambda ff: np.full(np.shape(ff), np.exp(white + 1.0 / dof))
+        return flat
 
     def log_model(q, logx):
         return np.logaddexp(q[0], q[1] - q[2] * logx)
@@ -163,10 +163,10 @@ def _noise_model(f: np.ndarray, S: np.ndarray, top: float, dof: float):
                                     bounds=([-np.inf, -np.inf, 0.0], [np.inf, np.inf, 2.5]))
     ssr_power = float(2 * fitted.cost)
     coloured = (ssr_white - ssr_power) / 2 > COLOUR_F * ssr_power / (n - 3)
+    if not coloured:
+        return flat
     q = fitted.x
-    if coloured:
-        return lambda ff: np.exp(log_model(q, np.log(ff / top)) + 1.0 / dof)
-    return lambda ff: np.full(np.shape(ff), np.exp(white + 1.0 / dof))
+    return lambda ff: np.exp(log_model(q, np.log(ff / top)) + 1.0 / dof)
 
 
 def _psd(x: np.ndarray, nper: int) -> tuple[np.ndarray, np.ndarray]:
