@@ -32,7 +32,9 @@ class ResultIntervals:
         physical bound leave it up to their one-sided limits (``bound_reach``: the union of
         the intervals conditional on any such value); for an estimate at a bound the
         one-sided interval from the bound (:meth:`one_sided_limit`), up to the other bound
-        when the data do not determine it."""
+        when the data do not determine it. When a fitted pendulum is far heavier than its
+        tank mode (``mode_shifts``), the interval also reaches as far as the estimate moves
+        when that pendulum's mass is put at the mode's prediction (:attr:`mode_reach`)."""
         i = self._index(name)
         e = self.problem.estimated[i]
         if not self.free[i]:
@@ -41,27 +43,55 @@ class ResultIntervals:
                 return float(e.lower), (float(e.upper) if limit is None else min(limit, e.upper))
             return (float(e.lower) if limit is None else max(limit, e.lower)), float(e.upper)
         reach = (0.0, 0.0) if self.bound_reach is None else self.bound_reach[i]
-        lo, hi = self._widened(self.values[i], self.stderr[i], reach, level)
+        moved = (0.0, 0.0) if self.mode_reach is None else self.mode_reach[i]
+        lo, hi = self._widened(self.values[i], self.stderr[i], reach, level, moved)
         return max(lo, float(e.lower)), min(hi, float(e.upper))
 
     def derived_interval(self, name: str, level: float = 0.95) -> tuple[float, float]:
         """The ``level`` (default 0.95) interval of the derived quantity ``name``
         (``derived``; delta method conditional on the estimates held at bounds, reaching off
-        them as :meth:`interval`)."""
+        them and to a conflicting mode's prediction as :meth:`interval`)."""
         if name not in self.derived:
             raise InputError(f"{name!r} is not a derived quantity of this fit; derived: "
                              f"{', '.join(self.derived) or 'none'}")
         v, se = self.derived[name]
         se, *reach = self.derived_reach.get(name, (se, 0.0, 0.0))
-        return self._widened(v, se, reach, level)
+        return self._widened(v, se, reach, level, self.derived_mode_reach.get(name, (0.0, 0.0)))
 
-    def _widened(self, value: float, se: float, reach, level: float) -> tuple[float, float]:
-        """``value +/- t se``, widened by the one-sided quantile times ``reach`` (down, up)."""
+    def _widened(self, value: float, se: float, reach, level: float,
+                 moved=(0.0, 0.0)) -> tuple[float, float]:
+        """``value +/- t se``, widened by the one-sided quantile times ``reach`` (down, up)
+        and by ``moved`` (down, up; the union of the intervals at the value and at the
+        value moved)."""
         from scipy.stats import t as student
 
         q = float(student.ppf(0.5 + level / 2, self.dof))
         q1 = float(student.ppf(level, self.dof))
-        return (float(value - q * se - q1 * reach[0]), float(value + q * se + q1 * reach[1]))
+        return (float(value - q * se - q1 * reach[0] - moved[0]),
+                float(value + q * se + q1 * reach[1] + moved[1]))
+
+    @property
+    def mode_reach(self) -> np.ndarray | None:
+        """``(estimates, 2)``: how far each estimate moves down and up when the pendulum
+        masses far above their tank modes (``mode_shifts``) are put at the predictions,
+        each alone (zero for an estimate at a bound); ``None`` when there are none."""
+        if not self.mode_shifts:
+            return None
+        from .result import reach_sides
+
+        sides = reach_sides(np.column_stack([m for _, m in self.mode_shifts]))
+        return np.where(np.array(self.free, bool)[:, None], sides, 0.0)
+
+    def reach_text(self, i: int) -> str:
+        """What widens the 95 % interval of estimate ``i`` beyond its standard error, in
+        words, or ''."""
+        why = []
+        if self.bound_reach is not None and np.any(self.bound_reach[i]):
+            why.append("off the held bounds")
+        if self.mode_reach is not None and np.any(self.mode_reach[i]):
+            why.append("to " + ", ".join(f"{label}" for label, m in self.mode_shifts
+                                         if m[i] != 0))
+        return " and ".join(why)
 
     def one_sided_limit(self, name: str, level: float = 0.95) -> float | None:
         """For an estimate ``name`` at a bound: the one-sided ``level`` confidence limit away
@@ -85,9 +115,10 @@ class ResultIntervals:
         bound widens it), or what stands for it at a bound."""
         if self.free[i]:
             text = f"+/- {self.stderr[i]:.3g}"
-            if self.bound_reach is not None and np.any(self.bound_reach[i]):
+            why = self.reach_text(i)
+            if why:
                 lo, hi = self.interval(self.names[i])
-                text += f" (95 %: [{lo:.6g}, {hi:.6g}] off the held bounds)"
+                text += f" (95 %: [{lo:.6g}, {hi:.6g}] {why})"
             return text
         e = self.problem.estimated[i]
         side = self.at_bound[i]
@@ -180,7 +211,7 @@ class ResultIntervals:
                 text += ("Here the Gauss-Newton standard errors are optimistic: the robust ones "
                          "are " + ", ".join(f"{r:.2g}x for `{n}`" for n, r in worse.items())
                          + ". ")
-        return text + self._reach_note() + _PROFILE_HINT
+        return text + self._reach_note() + self._mode_note() + _PROFILE_HINT
 
     def _reach_note(self) -> str:
         """What the intervals add for the estimates held at physical bounds, or ''."""
@@ -199,3 +230,23 @@ class ResultIntervals:
                 "move with it reach as far as they move when it leaves the bound up to its "
                 "one-sided 95 % limit (the union of the intervals conditional on any such "
                 "value): " + ", ".join(moved) + ". ")
+
+    def _mode_note(self) -> str:
+        """What the intervals add for pendulums far heavier than their tank modes, or ''."""
+        if not self.mode_shifts:
+            return ""
+        parts = []
+        for label, m in self.mode_shifts:
+            # the moves of at least a tenth of a standard error
+            moved = [f"`{n}` {v:+.3g}" for n, v, se, f in zip(self.names, m, self.stderr, self.free)
+                     if f and v != 0 and not abs(v) < 0.1 * se]
+            parts.append(f"{label}: " + ", ".join(moved))
+        from .initial import PREDICTION_FACTOR
+
+        return (f"A fitted pendulum is more than {PREDICTION_FACTOR:g} times its tank mode's "
+                "predicted mass: it may "
+                "stand for something else in the record than that mode (a second fixed mass, "
+                "the noise near its frequency), and the estimates that move with it would "
+                "then be elsewhere. The 95 % intervals reach as far as the estimates move "
+                "(the regression in the covariance) when its mass is put at the prediction "
+                "(the union of the intervals at the fit and there): " + "; ".join(parts) + ". ")

@@ -18,7 +18,29 @@ if TYPE_CHECKING:  # pragma: no cover
 
 from .intervals import OPTIMISTIC_FACTOR, ResultIntervals
 
-__all__ = ["FitResult", "OPTIMISTIC_FACTOR", "derived_quantities", "reach_sides"]
+__all__ = ["FitResult", "OPTIMISTIC_FACTOR", "derived_quantities", "derived_shifts",
+           "reach_sides"]
+
+def _derived_jacobian(problem: "FitProblem", theta: np.ndarray):
+    """``(found, values, J)``: the quantities the model derives at the estimates of case 0
+    (:meth:`analogs.Model.derived_quantities`), their values and their Jacobian w.r.t. the
+    estimates; ``found`` empty when it derives none."""
+    th = ca.MX.sym("theta", theta.size)
+    vals: dict[str, Any] = dict(problem.fixed[0])
+    for j, e in enumerate(problem.estimated):
+        if e.case in (None, 0):
+            vals[e.parameter] = th[j]
+    labels = [e.name for e in problem.estimated]
+    for t in problem.ties:
+        vals[t.parameter] = t.constant + sum(k * th[labels.index(n)] for n, k in t.terms)
+    found = problem.model.derived_quantities(vals)
+    if not found:
+        return {}, np.zeros(0), np.zeros((0, theta.size))
+    e = ca.vertcat(*[ca.MX(v) if not isinstance(v, ca.MX) else v for v, _ in found.values()])
+    fn = ca.Function("derived", [th], [e, ca.jacobian(e, th)])
+    v, J = fn(theta)
+    return found, np.asarray(v).ravel(), np.asarray(J)
+
 
 def derived_quantities(problem: "FitProblem", theta: np.ndarray, cov: np.ndarray,
                        held: np.ndarray | None = None, reach: np.ndarray | None = None
@@ -31,21 +53,9 @@ def derived_quantities(problem: "FitProblem", theta: np.ndarray, cov: np.ndarray
     estimates ``held`` at a bound (their rows of ``cov`` are zero) and the reach off those
     bounds per unit one-sided quantile along the regression ``reach`` (:func:`reach_sides`).
     A quantity that depends on a held estimate has no standard error (NaN)."""
-    th = ca.MX.sym("theta", theta.size)
-    vals: dict[str, Any] = dict(problem.fixed[0])
-    for j, e in enumerate(problem.estimated):
-        if e.case in (None, 0):
-            vals[e.parameter] = th[j]
-    labels = [e.name for e in problem.estimated]
-    for t in problem.ties:
-        vals[t.parameter] = t.constant + sum(k * th[labels.index(n)] for n, k in t.terms)
-    found = problem.model.derived_quantities(vals)
+    found, v, J = _derived_jacobian(problem, theta)
     if not found:
         return {}, {}, {}
-    e = ca.vertcat(*[ca.MX(v) if not isinstance(v, ca.MX) else v for v, _ in found.values()])
-    fn = ca.Function("derived", [th], [e, ca.jacobian(e, th)])
-    v, J = fn(theta)
-    v, J = np.asarray(v).ravel(), np.asarray(J)
     se = np.sqrt(np.clip(np.einsum("ij,jk,ik->i", J, cov, J), 0, None))
     shown = se.copy()
     if held is not None and np.any(held):
@@ -54,6 +64,15 @@ def derived_quantities(problem: "FitProblem", theta: np.ndarray, cov: np.ndarray
     return ({k: (float(a), float(b)) for k, a, b in zip(found, v, shown)},
             {k: unit for k, (_, unit) in found.items()},
             {k: (float(a), float(b), float(c)) for k, a, (b, c) in zip(found, se, sides)})
+
+
+def derived_shifts(problem: "FitProblem", theta: np.ndarray, shifts: np.ndarray
+                   ) -> dict[str, tuple[float, float]]:
+    """Per derived quantity, ``(down, up)``: how far it moves (to first order) when the
+    estimates move by the columns of ``shifts`` (:attr:`FitResult.mode_shifts`), each
+    alone (:func:`reach_sides`)."""
+    found, _, J = _derived_jacobian(problem, theta)
+    return {k: (float(a), float(b)) for k, (a, b) in zip(found, reach_sides(J @ shifts))}
 
 
 def reach_sides(reach: np.ndarray) -> np.ndarray:
@@ -189,6 +208,15 @@ class FitResult(ResultIntervals):
     #: depends on one) and its reach as ``bound_reach``.
     derived_reach: dict[str, tuple[float, float, float]] = field(default_factory=dict,
                                                                  repr=False)
+    #: Per fitted pendulum mass above ``PREDICTION_FACTOR`` times its tank mode's predicted
+    #: mass (:mod:`estimate.fitting.mode_conflicts`): its label and how every estimate moves
+    #: (``names`` order, SI units) when that mass is put at the prediction, the others along
+    #: the regression in the covariance. Such a pendulum may stand for something else in the
+    #: record than its mode; the intervals reach as far as these moves (:attr:`mode_reach`).
+    mode_shifts: tuple[tuple[str, np.ndarray], ...] = field(default=(), repr=False)
+    #: Per derived quantity, ``(down, up)``: how far it moves with :attr:`mode_shifts`.
+    derived_mode_reach: dict[str, tuple[float, float]] = field(default_factory=dict,
+                                                               repr=False)
     #: The linear bounds the estimates end on (the masses within the liquid,
     #: :mod:`estimate.fitting.budget`), in words; the covariance holds them there.
     active_bounds: tuple[str, ...] = ()

@@ -17,7 +17,7 @@ from .covariance import uncertainty
 from .mode_conflicts import mode_conflicts
 from .noise_figures import case_figures, model_error_factor
 from .problem import FitProblem
-from .result import FitResult, derived_quantities, reach_sides
+from .result import FitResult, derived_quantities, derived_shifts, reach_sides
 from .terms import CaseTerms
 from .transcription import Transcription
 
@@ -175,8 +175,14 @@ def fit_result(problem: FitProblem, solve: Solve) -> FitResult:
         away, np.ones(unc.bound_reach.shape[1] - away.size)][None, :]
     bound_stderr = None if unc.bound_stderr is None else widen * unc.bound_stderr
     derived, derived_units, derived_reach = derived_quantities(problem, theta, cov, held, reach)
-    warnings += mode_conflicts(problem, theta, stderr, cov,
-                               {k: v[0] for k, v in derived.items()})
+    conflicts = mode_conflicts(problem, theta, stderr, cov, {k: v[0] for k, v in derived.items()})
+    warnings += [c.message for c in conflicts if c.message]
+    # a pendulum far heavier than its tank mode may stand for something else: the intervals
+    # reach to where the estimates go when its mass is put at the mode's prediction
+    mode_shifts = tuple((f"`{c.name}` at its tank mode's {c.predicted:.3g} kg",
+                         np.where(free, c.shift(theta, cov), 0.0)) for c in conflicts)
+    derived_mode_reach = derived_shifts(problem, theta, np.column_stack(
+        [m for _, m in mode_shifts])) if mode_shifts else {}
     return FitResult(
         problem=problem,
         values=theta, stderr=stderr, covariance=cov,
@@ -204,6 +210,7 @@ def fit_result(problem: FitProblem, solve: Solve) -> FitResult:
         bound_reach=None if reach is None else np.where(free[:, None], reach_sides(reach), 0.0),
         bound_directions=_directions(problem, reach, held, bound_stderr, active),
         derived_reach=derived_reach,
+        mode_shifts=mode_shifts, derived_mode_reach=derived_mode_reach,
         active_bounds=tuple(b.text for b in active), noise_figures=figures,
         gauss_newton_covariance=unc.covariance, robust_covariance=robust,
         covariance_kind=kind, bandwidths=unc.bandwidths, model_error=widen,

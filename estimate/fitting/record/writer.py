@@ -140,7 +140,14 @@ def fit_record(result: "FitResult", *, model_spec: str | None = None,
                        "off_bounds": [{"bound": label,
                                        "move": {nm: float(v) for nm, v in zip(result.names, col)
                                                 if v != 0.0}}
-                                      for label, col in result.bound_directions]},
+                                      for label, col in result.bound_directions],
+                       # how the estimates move when a pendulum far heavier than its tank
+                       # mode is put at the prediction (FitResult.mode_shifts); the
+                       # intervals reach that far
+                       "to_predicted_modes": [{"mode": label,
+                                               "move": {nm: float(v) for nm, v in
+                                                        zip(result.names, col) if v != 0.0}}
+                                              for label, col in result.mode_shifts]},
         "correlation": result.correlation[np.ix_(free, free)].tolist(),
         "initial_states": {e.case.test.id: dict(x) for e, x in
                            zip(experiments, result.initial_states)},

@@ -191,3 +191,25 @@ def test_intervals_cover_the_masses_of_long_sine_records_through_a_transducer(tm
     print(f"\ncovered {hits}, z spread {spread}")  # the counts, with -s
     assert all(h >= 26 for h in hits.values()), hits
     assert all(s <= 1.25 for s in spread.values()), spread
+
+
+@pytest.mark.slow
+def test_the_fixed_mass_is_covered_when_a_mode_the_record_lacks_is_fitted(tmp_path):
+    """6 s sine records from rest (0.9 f1, one mode, fixed mass 1.5 kg), fitted with
+    ``fixed,p1,p2``: in about half the draws ``p2`` hunts the noise near its frequency and
+    ends 4-12 times its mode's predicted mass, the fixed mass its partner (correlation
+    -0.98), and the fixed mass's local intervals missed the truth in 13 of 18 draws (seeds
+    2-19). With the intervals reaching to ``p2`` at its prediction
+    (``FitResult.mode_shifts``) they missed 3 (all by under 1 %, with ``p2`` near its
+    prediction). Unseen seeds 40-51: at least 9 of 12 (measured 10; the local intervals
+    alone cover 4)."""
+    hits, spurious = 0, 0
+    for seed in range(40, 52):
+        case, _, truth = rig_record(tmp_path, f"m{seed}",
+                                    lambda f1: ref.Sine(0.0025, 0.9 * f1), seed=seed)
+        res = fit(FitProblem.build(case, model_from_spec("fixed,p1,p2", case)), progress=False)
+        lo, hi = res.interval("fixed.mass")
+        hits += lo <= truth["fixed.mass"] <= hi
+        spurious += bool(res.mode_shifts)
+    print(f"\nfixed mass covered {hits} of 12; p2 above 3x its prediction in {spurious}")
+    assert hits >= 9, (hits, spurious)
