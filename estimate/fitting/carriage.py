@@ -116,14 +116,16 @@ def noise_band(top_frequency: float) -> float:
 
 
 def record_noise(time: np.ndarray, force: np.ndarray, top_frequency: float, *,
-                 quiet: tuple[tuple[int, int], ...] = ()) -> RecordNoise:
+                 quiet: tuple[tuple[int, int], ...] = (),
+                 without_tones: tuple[np.ndarray, tuple] | None = None) -> RecordNoise:
     """Noise figure and tones of a recorded force (N) whose mechanics reach up to
     ``top_frequency`` (Hz): tones read above ``max(3 top_frequency, 12 Hz)``; the figure from
     the ``quiet`` segments (index ranges) when there are any, else provisionally the white
-    level above that band."""
+    level above that band. ``without_tones``: what :func:`remove_tones` gave for this force
+    and band, when the caller has it."""
     band = noise_band(top_frequency)
     F = np.asarray(force, float)
-    clean, tones = remove_tones(time, F, above_hz=band)
+    clean, tones = without_tones or remove_tones(time, F, above_hz=band)
     floor = NOISE_FLOOR * float(np.sqrt(np.mean(F**2)))
     if quiet:
         figure = segment_noise(time, clean, quiet, detail=_quiet_text(time, quiet))
@@ -205,10 +207,10 @@ def _carriage_input(time: np.ndarray, displacement: np.ndarray, force: np.ndarra
     band = noise_band(f_top)
     x_clean, x_tones = remove_tones(t, x, above_hz=band)
     sx = max(noise_level(t, x_clean, above_hz=band), NOISE_FLOOR * float(np.std(x)))
-    F_clean, _ = remove_tones(t, np.asarray(force, float), above_hz=band)
+    F_clean, F_tones = remove_tones(t, np.asarray(force, float), above_hz=band)
     quiet = quiet_segments(t, x_clean, F_clean, displacement_noise=sx, band_hz=band,
                            starts_at_rest=at_rest)
-    noise = record_noise(t, force, f_top, quiet=quiet)
+    noise = record_noise(t, force, f_top, quiet=quiet, without_tones=(F_clean, F_tones))
     if quiet:
         sx = max(sx, segment_noise(t, x_clean, quiet).std)
     if at_rest is None:
