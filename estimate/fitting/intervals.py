@@ -89,8 +89,7 @@ class ResultIntervals:
         if self.bound_reach is not None and np.any(self.bound_reach[i]):
             why.append("off the held bounds")
         if self.mode_reach is not None and np.any(self.mode_reach[i]):
-            why.append("to " + ", ".join(f"{label}" for label, m in self.mode_shifts
-                                         if m[i] != 0))
+            why.append("to " + ", ".join(label for label, m in self.mode_shifts if m[i] != 0))
         return " and ".join(why)
 
     def one_sided_limit(self, name: str, level: float = 0.95) -> float | None:
@@ -238,15 +237,16 @@ class ResultIntervals:
         parts = []
         for label, m in self.mode_shifts:
             # the moves of at least a tenth of a standard error
-            moved = [f"`{n}` {v:+.3g}" for n, v, se, f in zip(self.names, m, self.stderr, self.free)
+            moved = [f"`{n}` {v:+.3g}" for n, v, se, f
+                     in zip(self.names, m, self.stderr, self.free)
                      if f and v != 0 and not abs(v) < 0.1 * se]
             parts.append(f"{label}: " + ", ".join(moved))
         from .initial import PREDICTION_FACTOR
 
         return (f"A fitted pendulum is more than {PREDICTION_FACTOR:g} times its tank mode's "
-                "predicted mass: it may "
-                "stand for something else in the record than that mode (a second fixed mass, "
-                "the noise near its frequency), and the estimates that move with it would "
-                "then be elsewhere. The 95 % intervals reach as far as the estimates move "
-                "(the regression in the covariance) when its mass is put at the prediction "
-                "(the union of the intervals at the fit and there): " + "; ".join(parts) + ". ")
+                "predicted mass: it may stand for something else in the record than that "
+                "mode (a second fixed mass, the noise near its frequency), and the estimates "
+                "that move with it would then be elsewhere. The 95 % intervals reach as far "
+                "as the estimates move (the regression in the covariance) when its mass is "
+                "put at the prediction (the union of the intervals at the fit and there): "
+                + "; ".join(parts) + ". ")
