@@ -6,7 +6,9 @@ and the campaign:
 
 * a record with quiet segments (the rest before the drive, a settled end) has its figure
   before any fit (:func:`estimate.fitting.carriage.record_noise`), and that figure weighs
-  the force residuals;
+  the force residuals; after the fit the residual's wander below its 2 s segments joins it
+  (:func:`~estimate.data.signals.noise_figure.quiet_wander`: a second of rest cannot show
+  a transducer's 1/f noise wandering over a minute);
 * otherwise a first fit is weighed by the force's white level above the signal band (a
   provisional figure), and the figure is read from that fit's residual
   (:func:`~estimate.data.signals.noise_figure.residual_noise`); when the two differ by more
@@ -37,7 +39,7 @@ from typing import TYPE_CHECKING
 
 import numpy as np
 
-from ..data.signals.noise_figure import NoiseFigure, residual_noise
+from ..data.signals.noise_figure import NoiseFigure, quiet_wander, residual_noise
 from .carriage import adopt_noise
 
 if TYPE_CHECKING:  # pragma: no cover
@@ -65,17 +67,18 @@ MODEL_ERROR_MARGIN = 1.15
 def case_figures(problem: "FitProblem", case: int, residual: np.ndarray,
                  weights: np.ndarray) -> dict[str, NoiseFigure]:
     """Per fitted channel of ``case`` (N, N m), its noise figure: the quiet segments' (known
-    before the fit) or the fit's ``residual``'s (samples with ``weights`` > 0)."""
+    before the fit; with the ``residual``'s wander below its segments) or the fit's
+    ``residual``'s (samples with ``weights`` > 0)."""
     t = np.asarray(problem.experiments[case].case.time, float)
     names = problem.channels(case)
     known = problem.noise[case] if problem.noise else None
     out = {}
     for j, name in enumerate(names):
+        r = residual if residual.ndim == 1 else residual[:, j]
         if known is not None and known.figure is not None and known.figure.source == "quiet" \
                 and len(names) == 1:
-            out[name] = known.figure
+            out[name] = quiet_wander(t, r, weights, known.figure)
             continue
-        r = residual if residual.ndim == 1 else residual[:, j]
         out[name] = residual_noise(t, r, weights,
                                    peaks_below_hz=None if known is None else known.band_hz)
     return out

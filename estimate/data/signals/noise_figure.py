@@ -23,7 +23,7 @@ Either way the noise's colour is described by an autoregressive model
 from __future__ import annotations
 
 import math
-from dataclasses import dataclass
+from dataclasses import dataclass, replace
 
 import numpy as np
 from numpy.typing import ArrayLike
@@ -32,7 +32,7 @@ from scipy.ndimage import median_filter
 
 from ._common import _as_uniform
 
-__all__ = ["NoiseFigure", "quiet_segments", "segment_noise", "residual_noise"]
+__all__ = ["NoiseFigure", "quiet_segments", "segment_noise", "residual_noise", "quiet_wander"]
 
 #: Shortest quiet segment used [s] (and at least QUIET_MIN_SAMPLES samples).
 QUIET_MIN_SECONDS = 0.5
@@ -64,6 +64,10 @@ SINE_SHARE_MAX = 0.5
 PEAK_FACTOR = 2.5
 #: Half width of the running median a bin is compared with [Hz] (at least 6 bins).
 PEAK_WINDOW_HZ = 1.5
+#: Residual segments whose variance about their own straight line is at most this many
+#: times a quiet figure's are noise-like: their wander joins that figure
+#: (:func:`quiet_wander`).
+WANDER_SEGMENT_FACTOR = 2.0
 #: Largest autoregressive order of a noise model.
 MAX_AR_ORDER = 12
 
@@ -288,19 +292,61 @@ def _expected_median(k: int) -> float:
     return 0.5 * (order(k // 2) + order(k // 2 + 1))
 
 
-def _slow_variance(t: np.ndarray, r: np.ndarray, keep: np.ndarray, starts: list[int],
-                   nper: int) -> float:
-    """The mean over the segments (``nper`` samples from each of ``starts``) of the variance
-    their own straight lines hold of ``r`` once the straight line through its ``keep``
-    samples is removed: the residual's wander below the segments' resolution, less an
-    offset and a drift over the record."""
+def _segments(r: np.ndarray, weights, samples: float) -> tuple[np.ndarray, list[int], int]:
+    """``(keep, starts, nper)``: the samples with ``weights`` > 0, and the starts of the
+    non-overlapping segments of ``nper`` (about ``samples``; at least 8 segments when the
+    kept samples allow, at least 32 samples) lying wholly inside the kept samples."""
+    keep = np.ones(r.size, bool) if weights is None else np.asarray(weights, float) > 0
+    nper = max(min(int(round(samples)), int(np.count_nonzero(keep)) // 8), 32)
+    starts = []
+    i = 0
+    while i + nper <= r.size:
+        gaps = np.flatnonzero(~keep[i:i + nper])
+        if gaps.size == 0:
+            starts.append(i)
+            i += nper
+        else:
+            i += int(gaps[-1]) + 1
+    return keep, starts, nper
+
+
+def _wander(t: np.ndarray, r: np.ndarray, keep: np.ndarray, starts: list[int], nper: int
+            ) -> tuple[np.ndarray, np.ndarray]:
+    """Per segment (``nper`` samples from each of ``starts``), once the straight line
+    through the ``keep`` samples of ``r`` is removed: the variance the segment's own
+    straight line holds (the wander below the segments' resolution, less an offset and a
+    drift over the record) and the variance about it."""
     tk = t[keep] - float(np.mean(t[keep]))
     A = np.column_stack([np.ones(tk.size), tk])
     c = np.linalg.lstsq(A, r[keep], rcond=None)[0]
     rg = r - c[0] - c[1] * (t - float(np.mean(t[keep])))
     segs = np.array([rg[s:s + nper] for s in starts])
-    return float(np.mean(np.mean(segs**2, axis=1)
-                         - np.mean(signal.detrend(segs, axis=1, type="linear") ** 2, axis=1)))
+    about = np.mean(signal.detrend(segs, axis=1, type="linear") ** 2, axis=1)
+    return np.mean(segs**2, axis=1) - about, about
+
+
+def quiet_wander(time: ArrayLike, residual: ArrayLike, weights: ArrayLike | None,
+                 figure: NoiseFigure, *, segment_seconds: float = 2.0) -> NoiseFigure:
+    """A quiet-segment ``figure`` with the wander of a fit's ``residual`` below the
+    segments added: a rest of a second or two cannot show a transducer's 1/f noise
+    wandering over a minute (60 s records with a 1.3 s rest left a correct model 1.15-1.25
+    x that figure). The wander is the mean variance the straight lines of the residual's
+    ``segment_seconds`` segments hold once the record's straight line is removed
+    (:func:`residual_noise`), over the noise-like segments only: those whose variance about
+    their own line is at most :data:`WANDER_SEGMENT_FACTOR` times the figure's (a
+    misfit's burst, such as a missed mode after a transport move, does not count)."""
+    t, r, step = _as_uniform(time, residual, "residual")
+    keep, starts, nper = _segments(r, weights, segment_seconds / step)
+    if len(starts) < 3 or not figure.std > 0:
+        return figure
+    wander, about = _wander(t, r, keep, starts, nper)
+    calm = about <= WANDER_SEGMENT_FACTOR * figure.std**2
+    if not np.any(calm):
+        return figure
+    extra = max(float(np.mean(wander[calm])), 0.0)
+    return replace(figure, std=math.sqrt(figure.std**2 + extra),
+                   detail=(figure.detail or "quiet segments")
+                   + f"; with the fit residual's wander below {nper * step:.3g} s")
 
 
 def residual_noise(time: ArrayLike, residual: ArrayLike, weights: ArrayLike | None = None, *,
@@ -328,19 +374,8 @@ def residual_noise(time: ArrayLike, residual: ArrayLike, weights: ArrayLike | No
     """
     t, r, step = _as_uniform(time, residual, "residual")
     fs = 1.0 / step
-    keep = np.ones(r.size, bool) if weights is None else np.asarray(weights, float) > 0
+    keep, starts, nper = _segments(r, weights, segment_seconds * fs)
     n_kept = int(np.count_nonzero(keep))
-    nper = int(round(segment_seconds * fs))
-    nper = max(min(nper, n_kept // 8), 32)
-    starts = []
-    i = 0
-    while i + nper <= r.size:
-        gaps = np.flatnonzero(~keep[i:i + nper])
-        if gaps.size == 0:
-            starts.append(i)
-            i += nper
-        else:
-            i += int(gaps[-1]) + 1
     if len(starts) < 3:
         std = float(np.std(r[keep])) if n_kept else math.nan
         return NoiseFigure(std, "residual", (), n_kept * step,
@@ -365,7 +400,7 @@ def residual_noise(time: ArrayLike, residual: ArrayLike, weights: ArrayLike | No
     # bins that are not peaks, so a flat spectrum keeps its level
     level = float(np.sum(psd[ordinary])) / max(float(np.sum(smooth[ordinary])), 1e-300)
     clean = np.where(ordinary, psd, smooth * level)
-    clean[0] += _slow_variance(t, r, keep, starts, nper) / df
+    clean[0] += float(np.mean(_wander(t, r, keep, starts, nper)[0])) / df
     variance = float(np.sum(clean) * df)
     two_sided = np.r_[clean, clean[-2:0:-1] if nper % 2 == 0 else clean[-1:0:-1]] * fs / 2
     acov = np.fft.ifft(two_sided).real[: MAX_AR_ORDER + 1]
