@@ -92,6 +92,15 @@ class ResultIntervals:
             why.append("to " + ", ".join(label for label, m in self.mode_shifts if m[i] != 0))
         return " and ".join(why)
 
+    def derived_reach_text(self, name: str) -> str:
+        """What widens the 95 % interval of the derived quantity ``name`` beyond its
+        standard error, in words, or ''."""
+        why = [w for w, on in (
+            ("off the held bounds", any(self.derived_reach.get(name, (0.0, 0.0, 0.0))[1:])),
+            ("to the tank modes' predicted masses",
+             any(self.derived_mode_reach.get(name, (0.0, 0.0))))) if on]
+        return " and ".join(why)
+
     def one_sided_limit(self, name: str, level: float = 0.95) -> float | None:
         """For an estimate ``name`` at a bound: the one-sided ``level`` confidence limit away
         from the bound (``bound +/- t_level * bound_stderr``), ``None`` when the data do not

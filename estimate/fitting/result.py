@@ -18,10 +18,10 @@ if TYPE_CHECKING:  # pragma: no cover
 
 from .intervals import OPTIMISTIC_FACTOR, ResultIntervals
 
-__all__ = ["FitResult", "OPTIMISTIC_FACTOR", "derived_quantities", "derived_shifts",
-           "reach_sides"]
+__all__ = ["FitResult", "OPTIMISTIC_FACTOR", "derived_jacobian", "derived_quantities",
+           "derived_shifts", "reach_sides"]
 
-def _derived_jacobian(problem: "FitProblem", theta: np.ndarray):
+def derived_jacobian(problem: "FitProblem", theta: np.ndarray):
     """``(found, values, J)``: the quantities the model derives at the estimates of case 0
     (:meth:`analogs.Model.derived_quantities`), their values and their Jacobian w.r.t. the
     estimates; ``found`` empty when it derives none."""
@@ -43,8 +43,8 @@ def _derived_jacobian(problem: "FitProblem", theta: np.ndarray):
 
 
 def derived_quantities(problem: "FitProblem", theta: np.ndarray, cov: np.ndarray,
-                       held: np.ndarray | None = None, reach: np.ndarray | None = None
-                       ) -> tuple[dict[str, tuple[float, float]], dict[str, str],
+                       held: np.ndarray | None = None, reach: np.ndarray | None = None,
+                       jacobian=None) -> tuple[dict[str, tuple[float, float]], dict[str, str],
                                   dict[str, tuple[float, float, float]]]:
     """The quantities the model's components derive (:meth:`analogs.Model.derived_quantities`,
     e.g. ``pN.frequency_hz`` and ``pN.damping_ratio`` with the summed hinge and diaphragm
@@ -52,8 +52,9 @@ def derived_quantities(problem: "FitProblem", theta: np.ndarray, cov: np.ndarray
     for the intervals, ``(standard error, down, up)``: the standard error conditional on the
     estimates ``held`` at a bound (their rows of ``cov`` are zero) and the reach off those
     bounds per unit one-sided quantile along the regression ``reach`` (:func:`reach_sides`).
-    A quantity that depends on a held estimate has no standard error (NaN)."""
-    found, v, J = _derived_jacobian(problem, theta)
+    A quantity that depends on a held estimate has no standard error (NaN). ``jacobian``:
+    :func:`derived_jacobian` at ``theta``, when the caller has it."""
+    found, v, J = jacobian or derived_jacobian(problem, theta)
     if not found:
         return {}, {}, {}
     se = np.sqrt(np.clip(np.einsum("ij,jk,ik->i", J, cov, J), 0, None))
@@ -66,12 +67,11 @@ def derived_quantities(problem: "FitProblem", theta: np.ndarray, cov: np.ndarray
             {k: (float(a), float(b), float(c)) for k, a, (b, c) in zip(found, se, sides)})
 
 
-def derived_shifts(problem: "FitProblem", theta: np.ndarray, shifts: np.ndarray
-                   ) -> dict[str, tuple[float, float]]:
-    """Per derived quantity, ``(down, up)``: how far it moves (to first order) when the
-    estimates move by the columns of ``shifts`` (:attr:`FitResult.mode_shifts`), each
-    alone (:func:`reach_sides`)."""
-    found, _, J = _derived_jacobian(problem, theta)
+def derived_shifts(jacobian, shifts: np.ndarray) -> dict[str, tuple[float, float]]:
+    """Per derived quantity, ``(down, up)``: how far it moves (to first order, its
+    :func:`derived_jacobian` ``jacobian``) when the estimates move by the columns of
+    ``shifts`` (:attr:`FitResult.mode_shifts`), each alone (:func:`reach_sides`)."""
+    found, _, J = jacobian
     return {k: (float(a), float(b)) for k, (a, b) in zip(found, reach_sides(J @ shifts))}
 
 

@@ -17,7 +17,7 @@ from .covariance import uncertainty
 from .mode_conflicts import mode_conflicts
 from .noise_figures import case_figures, model_error_factor
 from .problem import FitProblem
-from .result import FitResult, derived_quantities, derived_shifts, reach_sides
+from .result import FitResult, derived_jacobian, derived_quantities, derived_shifts, reach_sides
 from .terms import CaseTerms
 from .transcription import Transcription
 
@@ -174,14 +174,16 @@ def fit_result(problem: FitProblem, solve: Solve) -> FitResult:
     reach = None if unc.bound_reach is None else widen * unc.bound_reach * np.r_[
         away, np.ones(unc.bound_reach.shape[1] - away.size)][None, :]
     bound_stderr = None if unc.bound_stderr is None else widen * unc.bound_stderr
-    derived, derived_units, derived_reach = derived_quantities(problem, theta, cov, held, reach)
+    jacobian = derived_jacobian(problem, theta)
+    derived, derived_units, derived_reach = derived_quantities(problem, theta, cov, held, reach,
+                                                               jacobian)
     conflicts = mode_conflicts(problem, theta, stderr, cov, {k: v[0] for k, v in derived.items()})
     warnings += [c.message for c in conflicts if c.message]
     # a pendulum far heavier than its tank mode may stand for something else: the intervals
     # reach to where the estimates go when its mass is put at the mode's prediction
     mode_shifts = tuple((f"`{c.name}` at its tank mode's {c.predicted:.3g} kg",
                          np.where(free, c.shift(theta, cov), 0.0)) for c in conflicts)
-    derived_mode_reach = derived_shifts(problem, theta, np.column_stack(
+    derived_mode_reach = derived_shifts(jacobian, np.column_stack(
         [m for _, m in mode_shifts])) if mode_shifts else {}
     return FitResult(
         problem=problem,

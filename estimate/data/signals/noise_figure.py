@@ -316,10 +316,10 @@ def _wander(t: np.ndarray, r: np.ndarray, keep: np.ndarray, starts: list[int], n
     through the ``keep`` samples of ``r`` is removed: the variance the segment's own
     straight line holds (the wander below the segments' resolution, less an offset and a
     drift over the record) and the variance about it."""
-    tk = t[keep] - float(np.mean(t[keep]))
-    A = np.column_stack([np.ones(tk.size), tk])
+    tc = t - float(np.mean(t[keep]))
+    A = np.column_stack([np.ones(int(np.count_nonzero(keep))), tc[keep]])
     c = np.linalg.lstsq(A, r[keep], rcond=None)[0]
-    rg = r - c[0] - c[1] * (t - float(np.mean(t[keep])))
+    rg = r - c[0] - c[1] * tc
     segs = np.array([rg[s:s + nper] for s in starts])
     about = np.mean(signal.detrend(segs, axis=1, type="linear") ** 2, axis=1)
     return np.mean(segs**2, axis=1) - about, about

@@ -140,13 +140,10 @@ def _derived(result: "FitResult") -> list[tuple[str, str, str, str]]:
         unit = result.derived_units.get(k, "")
         text = f"+/- {se:.3g}" if math.isfinite(se) else \
             "(no standard error: it depends on an estimate at a bound)"
-        why = [w for w, on in (
-            ("off the held bounds", any(result.derived_reach.get(k, (0.0, 0.0, 0.0))[1:])),
-            ("to the tank modes' predicted masses",
-             any(result.derived_mode_reach.get(k, (0.0, 0.0))))) if on]
+        why = result.derived_reach_text(k)
         if why:
             lo, hi = result.derived_interval(k)
-            text += f"; 95 % [{lo:.6g}, {hi:.6g}] {' and '.join(why)}"
+            text += f"; 95 % [{lo:.6g}, {hi:.6g}] {why}"
         out.append((k, f"{v:.6g}", text, unit))
     return out
 
