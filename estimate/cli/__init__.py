@@ -141,6 +141,9 @@ def _one_line_warnings() -> Iterator[None]:
 
     with warnings.catch_warnings():
         warnings.simplefilter("default")
+        # an interrupt while Python reads a module's bytecode leaves its file to the garbage
+        # collector: the interpreter's housekeeping, not the command's, and not the user's
+        warnings.simplefilter("ignore", ResourceWarning)
         warnings.showwarning = show
         yield
 

@@ -38,3 +38,19 @@ def test_a_programming_error_is_not_disguised_as_a_user_error(monkeypatch):
 
 def test_input_error_is_a_value_error_for_library_users():
     assert issubclass(InputError, ValueError)
+
+
+def test_a_file_left_open_by_an_interrupted_import_is_not_a_warning_line(monkeypatch, capsys):
+    """A SIGINT while Python reads a module's bytecode leaves that file to the garbage
+    collector; its ResourceWarning is the interpreter's, and the interrupt's message must stay
+    the command's one line (seen on a loaded machine: 'warning: unclosed file <...pyc>')."""
+    import warnings
+
+    def leaky(args):
+        warnings.warn("unclosed file <_io.BufferedReader name='x.pyc'>", ResourceWarning)
+        warnings.warn("a user's warning", UserWarning)
+        return 0
+
+    monkeypatch.setattr(cli_fit, "run", leaky)
+    assert main(["fit", str(EXAMPLES / "A1.toml")]) == 0
+    assert capsys.readouterr().err == "warning: a user's warning\n"
