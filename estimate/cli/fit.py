@@ -82,11 +82,6 @@ def run(args: argparse.Namespace) -> int:
     import sys
 
     from ..data.models import BASELINE, model_from_spec
-    from ..fitting.measurement import ChannelOffsets
-    from ..fitting.nlp import fit
-    from ..fitting.problem import FitProblem
-    from ..fitting.record import fit_json, fit_record, report_markdown
-    from ..fitting.transcription import Collocation, MultipleShooting
 
     report_file = _report_file(args)
     outputs = Outputs(overwrite=args.overwrite, inputs=args.cases)
@@ -98,6 +93,13 @@ def run(args: argparse.Namespace) -> int:
         print(f"warning: {w}", file=sys.stderr)
     spec = BASELINE if args.model is None else args.model
     model = model_from_spec(spec, cases[0])
+    # the fit's libraries after the inputs are checked: a refused input costs no SciPy import
+    from ..fitting.measurement import ChannelOffsets
+    from ..fitting.nlp import fit
+    from ..fitting.problem import FitProblem
+    from ..fitting.record import fit_json, fit_record, report_markdown
+    from ..fitting.transcription import Collocation, MultipleShooting
+
     # the abs cost cannot tell the carriage's sign: it takes the filtered input; else the
     # input mode's default (estimate.fitting.strategies.DEFAULT_INPUT)
     mode = args.input or ("filtered" if args.cost == "abs" else None)

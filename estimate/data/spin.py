@@ -9,7 +9,6 @@ from collections.abc import Mapping
 
 import numpy as np
 from numpy.typing import NDArray
-from scipy.integrate import cumulative_trapezoid
 
 from analogs.errors import InputError
 from analogs.spinning import MOTION_INPUTS
@@ -61,6 +60,7 @@ def rig_angle_derivatives(time: NDArray[np.float64], angle: NDArray[np.float64],
 def spin_angles(case: Case) -> dict[str, NDArray[np.float64]]:
     """The measured rig angles of ``case`` by input name (rad): the spin angle (from a
     measured rate: its integral from 0), the nutation phase and the cone angle."""
+    from scipy.integrate import cumulative_trapezoid
     spin = _spin(case)
     cols = case.channels
     out = {}

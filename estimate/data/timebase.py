@@ -33,7 +33,6 @@ from dataclasses import dataclass
 
 import numpy as np
 from numpy.typing import NDArray
-from scipy.interpolate import CubicSpline
 
 __all__ = ["RATE_TOLERANCE", "SLIP_WINDOW", "UniformRecord", "uniform_record"]
 
@@ -89,6 +88,7 @@ def uniform_record(name: str, time: NDArray[np.float64],
     ``columns`` are the other channels (any units); ``max_samples`` bounds the samples of
     an interpolated record (the memory budget of a fit).
     """
+    from scipy.interpolate import CubicSpline
     t = np.asarray(time, float)
     step = 1.0 / rate_hz
     n = t.size

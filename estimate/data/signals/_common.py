@@ -4,7 +4,6 @@ from __future__ import annotations
 
 import numpy as np
 from numpy.typing import ArrayLike, NDArray
-from scipy import optimize
 
 _UNIFORM_RTOL = 1e-3          # same tolerance as the case loader (estimate.data.case.TIME_STEP_RTOL)
 _MIN_SAMPLES = 16
@@ -87,6 +86,7 @@ def _refine_frequency(t: NDArray[np.float64], y: NDArray[np.float64], f0: float,
     The residual has side lobes spaced 1/T apart (T the record length), so a grid finer than
     1/T locates the main lobe before a bounded scalar minimisation polishes it.
     """
+    from scipy import optimize
     tc = t - t.mean()
     span = float(t[-1] - t[0])
     lo, hi = max(f0 - half_width, 1e-6), f0 + half_width

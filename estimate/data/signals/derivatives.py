@@ -6,7 +6,6 @@ from typing import Literal
 
 import numpy as np
 from numpy.typing import ArrayLike, NDArray
-from scipy import signal
 
 from analogs.errors import InputError
 
@@ -83,6 +82,7 @@ def motion_band(time: ArrayLike, displacement: ArrayLike) -> float | None:
 
 def _savgol_window(freqs: list[float], step: float, polyorder: int, n: int) -> int:
     """Largest odd window whose 2nd-derivative gain error at `freqs` is <= _SAVGOL_RTOL."""
+    from scipy import signal
     best = polyorder + 1 if polyorder % 2 == 0 else polyorder + 2  # smallest odd window
     w_max = min(n - (1 - n % 2), int(2.0 / step) | 1)
     for window in range(best, w_max + 1, 2):
@@ -163,6 +163,7 @@ def displacement_derivatives(
     >>> bool(np.max(np.abs(xdd + w**2 * 0.0075 * np.sin(w * t))) < 0.02)   # m/s^2
     True
     """
+    from scipy import signal
     t, x, step = _as_uniform(time, displacement, "displacement")
     fs = 1.0 / step
     if method == "butterworth":

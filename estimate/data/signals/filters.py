@@ -6,7 +6,6 @@ from typing import Literal
 
 import numpy as np
 from numpy.typing import ArrayLike, NDArray
-from scipy import optimize, signal
 
 from ._common import _as_uniform, _sine_costs, _sine_design, _sine_fit
 from .spectra import dominant_frequency
@@ -20,6 +19,7 @@ MAX_PAD_RECORDS = 2
 def _end_model(t_win: NDArray[np.float64], x_win: NDArray[np.float64], t_new: NDArray[np.float64],
                fs: float) -> NDArray[np.float64]:
     """Fit line + sinusoid (with 2nd, 3rd harmonics) to one end window; evaluate at t_new."""
+    from scipy import optimize
     t0 = t_win[-1] if t_new[0] > t_win[-1] else t_win[0]
     tw, tn = t_win - t0, t_new - t0
     span = float(t_win[-1] - t_win[0])
@@ -108,6 +108,7 @@ def lowpass(time: ArrayLike, values: ArrayLike, *, cutoff_hz: float = 10.0, orde
     >>> bool(np.max(np.abs(err[100:-100])) < 1e-5), bool(np.max(np.abs(err)) < 0.02)
     (True, True)
     """
+    from scipy import signal
     t, y, step = _as_uniform(time, values, "values")
     fs = 1.0 / step
     if not 0.0 < cutoff_hz < 0.5 * fs:

@@ -5,7 +5,6 @@ from __future__ import annotations
 
 import numpy as np
 from numpy.typing import ArrayLike
-from scipy import signal
 
 from ._common import _as_uniform, _refine_frequency
 
@@ -44,6 +43,7 @@ def noise_level(time: ArrayLike, values: ArrayLike, *, above_hz: float) -> float
     >>> round(noise_level(t, y, above_hz=10.0), 3)
     0.02
     """
+    from scipy import signal
     t, y, step = _as_uniform(time, values, "values")
     fs = 1.0 / step
     f, p = signal.welch(y, fs=fs, window="hann", nperseg=min(t.size, 256),
@@ -97,6 +97,7 @@ def remove_tones(time: ArrayLike, values: ArrayLike, *, above_hz: float,
     are fitted together (offset, trend and one sinusoid each) and subtracted. Only the band
     above the signal is searched, so nothing of the mechanics is removed.
     """
+    from scipy import signal
     t, y, step = _as_uniform(time, values, "values")
     fs = 1.0 / step
     top = _BAND_TOP * fs / 2

@@ -27,8 +27,6 @@ from dataclasses import dataclass, replace
 
 import numpy as np
 from numpy.typing import ArrayLike
-from scipy import linalg, signal, stats
-from scipy.ndimage import median_filter
 
 from ._common import _as_uniform
 
@@ -141,6 +139,7 @@ def _sine_share(t: np.ndarray, y: np.ndarray, top_hz: float, cycles: float = 2.0
     """Share of ``y``'s (detrended) variance the best single sinusoid between
     ``cycles / T`` and ``top_hz`` explains, and the share the best one takes of white noise
     of that length."""
+    from scipy import signal
     n = y.size
     fs = 1.0 / float(t[1] - t[0])
     f, p = signal.periodogram(y, fs=fs, detrend="linear", scaling="spectrum")
@@ -221,6 +220,7 @@ def _quiet(t: np.ndarray, y: np.ndarray, band_hz: float, cycles: float = 2.0) ->
     is not noisier than its first (:data:`QUIET_F_LEVEL`), and no sinusoid below ``band_hz``
     stands out (:data:`SINE_SHARE_FACTOR`). The rest before the drive is tested as is, the
     settled end reversed (its part nearest the motion first)."""
+    from scipy import stats
     d = _detrended(y)  # quarters and halves about the segment's line, not their own
     v = np.array([float(q @ q) / q.size for q in np.array_split(d, 4)])
     if v.min() <= 0 or v.max() > QUIET_VARIANCE_RATIO * v.min():
@@ -234,6 +234,7 @@ def _quiet(t: np.ndarray, y: np.ndarray, band_hz: float, cycles: float = 2.0) ->
 
 
 def _detrended(y: np.ndarray) -> np.ndarray:
+    from scipy import signal
     return signal.detrend(y, type="linear")
 
 
@@ -251,6 +252,7 @@ def _autocovariance(pieces: list[np.ndarray], lags: int) -> np.ndarray:
 
 def _yule_walker(acov: np.ndarray, n: int) -> tuple[float, ...]:
     """AR coefficients from an autocovariance, the order chosen by AIC (``n`` samples)."""
+    from scipy import linalg
     if acov[0] <= 0:
         return ()
     best, best_aic = (), n * math.log(acov[0])
@@ -316,6 +318,7 @@ def _wander(t: np.ndarray, r: np.ndarray, keep: np.ndarray, starts: list[int], n
     through the ``keep`` samples of ``r`` is removed: the variance the segment's own
     straight line holds (the wander below the segments' resolution, less an offset and a
     drift over the record) and the variance about it."""
+    from scipy import signal
     tc = t - float(np.mean(t[keep]))
     A = np.column_stack([np.ones(int(np.count_nonzero(keep))), tc[keep]])
     c = np.linalg.lstsq(A, r[keep], rcond=None)[0]
@@ -372,6 +375,8 @@ def residual_noise(time: ArrayLike, residual: ArrayLike, weights: ArrayLike | No
     effect) stay out. The figure is the square root of the integral of what remains, and
     its AR model is fitted to the autocovariance that spectrum implies.
     """
+    from scipy import signal
+    from scipy.ndimage import median_filter
     t, r, step = _as_uniform(time, residual, "residual")
     fs = 1.0 / step
     keep, starts, nper = _segments(r, weights, segment_seconds * fs)

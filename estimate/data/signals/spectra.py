@@ -6,7 +6,6 @@ from dataclasses import dataclass
 
 import numpy as np
 from numpy.typing import ArrayLike, NDArray
-from scipy import signal
 
 from analogs.errors import InputError
 
@@ -84,6 +83,7 @@ def welch_spectrum(time: ArrayLike, values: ArrayLike, *, nperseg: int | None = 
     >>> float(s.frequency[np.argmax(s.psd)])            # doctest: +ELLIPSIS
     2.0...
     """
+    from scipy import signal
     t, y, step = _as_uniform(time, values, "values")
     seg = max(_MIN_SAMPLES, t.size // 2) if nperseg is None else int(nperseg)
     if not _MIN_SAMPLES <= seg <= t.size:
@@ -136,6 +136,7 @@ def find_spectral_peaks(time: ArrayLike, values: ArrayLike, *, min_frequency: fl
     >>> [(round(p.frequency, 4), round(p.amplitude, 3)) for p in find_spectral_peaks(t, y)[:2]]
     [(1.855, 2.0), (3.71, 0.5)]
     """
+    from scipy import signal
     t, y, _ = _as_uniform(time, values, "values")
     spec = welch_spectrum(t, y, nperseg=nperseg)
     f, p = spec.frequency, spec.psd

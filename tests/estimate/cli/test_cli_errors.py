@@ -54,3 +54,22 @@ def test_a_file_left_open_by_an_interrupted_import_is_not_a_warning_line(monkeyp
     monkeypatch.setattr(cli_fit, "run", leaky)
     assert main(["fit", str(EXAMPLES / "A1.toml")]) == 0
     assert capsys.readouterr().err == "warning: a user's warning\n"
+
+
+def test_a_refused_case_file_does_not_load_the_fits_libraries(tmp_path):
+    """Loading and checking a case is NumPy's work; SciPy's signal, stats, optimize and
+    interpolate packages (1.5-2 s to import on a 2-core machine) load only when the fit runs,
+    so a typo in a case file is answered at once."""
+    import subprocess
+    import sys
+
+    toml = (EXAMPLES / "A1.toml").read_text().replace("dry_mass = 1.2", "dry_mass = 1e30")
+    (tmp_path / "bad.toml").write_text(toml)
+    (tmp_path / "A1.csv").write_bytes((EXAMPLES / "A1.csv").read_bytes())
+    code = ("import sys\nfrom estimate.cli import main\nstatus = main(['fit', 'bad.toml'])\n"
+            "heavy = [m for m in ('scipy.signal', 'scipy.stats', 'scipy.optimize', "
+            "'scipy.interpolate') if m in sys.modules]\nprint(status, heavy)\n")
+    proc = subprocess.run([sys.executable, "-c", code], cwd=tmp_path, capture_output=True,
+                          text=True, timeout=120)
+    assert "[rig] dry_mass: expected" in proc.stderr, proc.stderr
+    assert proc.stdout.strip() == "2 []", proc.stdout
