@@ -47,8 +47,8 @@ def test_a_file_left_open_by_an_interrupted_import_is_not_a_warning_line(monkeyp
     import warnings
 
     def leaky(args):
-        warnings.warn("unclosed file <_io.BufferedReader name='x.pyc'>", ResourceWarning)
-        warnings.warn("a user's warning", UserWarning)
+        warnings.warn("unclosed file <_io.BufferedReader name='x.pyc'>", ResourceWarning, stacklevel=2)
+        warnings.warn("a user's warning", UserWarning, stacklevel=2)
         return 0
 
     monkeypatch.setattr(cli_fit, "run", leaky)

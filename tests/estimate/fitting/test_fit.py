@@ -96,7 +96,7 @@ def test_frozen_mass_crank_workflow_succeeds_from_random_starts(tmp_path):
     model = model_from_spec("fixed", case)
     rng = np.random.default_rng(7)
     ok = 0
-    n = 40
+    n = 20
     for _ in range(n):
         start = {"fixed.mass": rng.uniform(1.81, 10.0),  # seed's lower bound 4 lb, up to 10 kg
                  "rig.omega_correction": rng.uniform(-0.5, 0.5),
