@@ -165,6 +165,8 @@ def fit_result(problem: FitProblem, solve: Solve) -> FitResult:
     # misses a small effect), where the Gauss-Newton one is optimistic
     kind = "robust" if robust is not None else "gauss-newton"
     cov = robust if robust is not None else unc.covariance
+    # the sandwich's products leave it asymmetric by rounding (1e-8 relative seen)
+    cov = 0.5 * (cov + cov.T)
     free = np.array([side is None for side in at_bound])
     stderr = np.where(free, np.sqrt(np.clip(np.diag(cov), 0, None)), np.nan)
     # the held estimates' regression columns, signed away from their bounds; the model error

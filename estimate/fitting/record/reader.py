@@ -50,6 +50,10 @@ class Fit:
         Per bound the covariance holds an estimate (or the masses) on: its label and how the
         estimates move, by name, when it leaves the bound by one standard deviation (SI
         units; empty for a record written before they were kept).
+    to_modes : tuple of (str, mapping)
+        Per pendulum far heavier than its tank mode's prediction (the fit's
+        ``covariance.to_predicted_modes``): its label and how every estimate moves, by name,
+        when that mass is put at the prediction (SI units; the intervals reach that far).
     stderr : mapping
         Standard error of each parameter (NaN when there is none: fixed, or at a bound).
     intervals : mapping
@@ -89,6 +93,7 @@ class Fit:
     covariance_names: tuple[str, ...]
     covariance: np.ndarray = field(repr=False)
     off_bounds: tuple[tuple[str, Mapping[str, float]], ...] = field(default=(), repr=False)
+    to_modes: tuple[tuple[str, Mapping[str, float]], ...] = field(default=(), repr=False)
     stderr: Mapping[str, float] = field(default_factory=dict, repr=False)
     intervals: Mapping[str, tuple[float, float]] = field(default_factory=dict, repr=False)
     derived: Mapping[str, tuple[float, float, str]] = field(default_factory=dict, repr=False)
@@ -107,8 +112,10 @@ class Fit:
     @property
     def draw_names(self) -> tuple[str, ...]:
         """The parameters a Monte Carlo draws: the covariance's, then those held on a bound
-        that move off it (:attr:`off_bounds`)."""
-        extra = [n for _, move in self.off_bounds for n in move if n not in self.covariance_names]
+        that move off it (:attr:`off_bounds`) or with a mode put at its prediction
+        (:attr:`to_modes`)."""
+        extra = [n for _, move in (*self.off_bounds, *self.to_modes) for n in move
+                 if n not in self.covariance_names]
         return self.covariance_names + tuple(dict.fromkeys(extra))
 
     @property
@@ -238,28 +245,30 @@ def _covariance(cov: Any, values: Mapping, problems: list[str]) -> tuple[tuple[s
     return tuple(names), np.array(rows, dtype=float).reshape(n, n)
 
 
-def _off_bounds(cov: Any, values: Mapping, problems: list[str]
-                ) -> tuple[tuple[str, dict[str, float]], ...]:
-    raw = cov.get("off_bounds") if isinstance(cov, Mapping) else None
+def _moves(cov: Any, values: Mapping, problems: list[str], key: str, label: str
+           ) -> tuple[tuple[str, dict[str, float]], ...]:
+    """The labelled moves of the estimates in ``covariance.<key>`` (``off_bounds``:
+    ``{"bound": ..., "move": {...}}``; ``to_predicted_modes``: ``{"mode": ..., ...}``)."""
+    raw = cov.get(key) if isinstance(cov, Mapping) else None
     if raw is None:
         return ()
     if not isinstance(raw, list):
-        problems.append(f"`covariance.off_bounds`: expected a list, found {raw!r}"[:300])
+        problems.append(f"`covariance.{key}`: expected a list, found {raw!r}"[:300])
         return ()
     out = []
     for i, entry in enumerate(raw):
-        where = f"`covariance.off_bounds[{i}]`"
+        where = f"`covariance.{key}[{i}]`"
         move = entry.get("move") if isinstance(entry, Mapping) else None
-        if not (isinstance(entry, Mapping) and isinstance(entry.get("bound"), str)
+        if not (isinstance(entry, Mapping) and isinstance(entry.get(label), str)
                 and isinstance(move, Mapping) and all(_is_number(v) for v in move.values())):
-            problems.append(f"{where}: expected an object with a \"bound\" string and a \"move\" "
-                            f"object of finite numbers, found {entry!r}"[:300])
+            problems.append(f"{where}: expected an object with a \"{label}\" string and a "
+                            f"\"move\" object of finite numbers, found {entry!r}"[:300])
             continue
         unknown = [n for n in move if n not in values]
         if unknown:
             problems.append(f"{where}.move: not in parameters: {', '.join(unknown)}")
             continue
-        out.append((entry["bound"], {n: float(v) for n, v in move.items()}))
+        out.append((entry[label], {n: float(v) for n, v in move.items()}))
     return tuple(out)
 
 
@@ -302,7 +311,8 @@ def read_fit(path: str | Path) -> Fit:
         case = None
     values, units, lower, upper, estimated, stderr, intervals = _parameters(params, problems)
     names, matrix = _covariance(data.get("covariance"), values, problems)
-    off_bounds = _off_bounds(data.get("covariance"), values, problems)
+    off_bounds = _moves(data.get("covariance"), values, problems, "off_bounds", "bound")
+    to_modes = _moves(data.get("covariance"), values, problems, "to_predicted_modes", "mode")
     derived, derived_intervals = _derived(data, problems)
     converged, status = data.get("converged"), data.get("status")
     cases = data.get("cases")
@@ -326,14 +336,15 @@ def read_fit(path: str | Path) -> Fit:
     keep = [i for i, n in enumerate(names) if not _stream_lag(n)]  # marginal of the analog
     names, matrix = tuple(names[i] for i in keep), np.asarray(matrix)[np.ix_(keep, keep)]
     estimated = [n for n in estimated if not _stream_lag(n)]
-    off_bounds = tuple((label, {n: v for n, v in move.items() if not _stream_lag(n)})
-                       for label, move in off_bounds)
+    off_bounds, to_modes = (tuple((label, {n: v for n, v in move.items() if not _stream_lag(n)})
+                                  for label, move in moves) for moves in (off_bounds, to_modes))
     for d in (values, units, lower, upper, stderr, intervals):
         for k in [k for k in d if _stream_lag(k)]:
             del d[k]
     return Fit(path=path, model_spec=str(spec), case=case, values=values, units=units,
                lower=lower, upper=upper, estimated=tuple(estimated), covariance_names=names,
-               covariance=matrix, off_bounds=off_bounds, stderr=stderr, intervals=intervals,
+               covariance=matrix, off_bounds=off_bounds, to_modes=to_modes, stderr=stderr,
+               intervals=intervals,
                derived=derived, derived_intervals=derived_intervals,
                converged=converged if isinstance(converged, bool) else None,
                status=status if isinstance(status, str) else None,

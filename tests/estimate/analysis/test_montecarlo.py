@@ -83,6 +83,14 @@ def test_draw_errors(tmp_path):
     bad = read_fit(fit_json(tmp_path / "a.json", cov=-COV))
     with pytest.raises(ValueError, match="not positive semi-definite"):
         draw_parameters(bad, 10)
+    # rounding asymmetry (a sandwich covariance's 1e-8) is drawn; a real one is refused
+    rounded, skew = COV.copy(), COV.copy()
+    rounded[0, 1] *= 1 + 2e-8
+    skew[0, 1] *= 1.1
+    assert draw_parameters(read_fit(fit_json(tmp_path / "r.json", cov=rounded)), 10)[0].shape \
+        == (10, 4)
+    with pytest.raises(ValueError, match="must be symmetric and finite"):
+        draw_parameters(read_fit(fit_json(tmp_path / "s.json", cov=skew)), 10)
     impossible = read_fit(fit_json(tmp_path / "b.json", lower_length=0.07, upper_length=0.0701))
     with pytest.raises(ValueError, match="inside the parameter bounds"):
         draw_parameters(impossible, 10, max_rounds=3)
@@ -195,6 +203,62 @@ def test_draws_leave_a_held_bound_half_normally_with_the_estimates_that_move_wit
     emp = np.cov(draws[:, :2].T)
     sd = np.sqrt(np.diag(COV[:2, :2]))
     assert np.all(np.abs(emp - COV[:2, :2]) < SAMPLE_MOMENTS * np.outer(sd, sd))
+
+
+def test_draws_fill_the_span_to_a_mode_at_its_prediction(tmp_path):
+    """A pendulum far heavier than its tank mode (``covariance.to_predicted_modes``): with
+    ``p1.mass`` put at the prediction the fixed mass takes what it leaves. Every draw moves
+    by ``u`` times that shift, ``u`` 0 or 1 with equal odds (mean 1/2, variance 1/4), on top
+    of the covariance: the sample moments of 40,000 draws against those formulas
+    (SAMPLE_MOMENTS of the standard deviations), and half the draws at each end."""
+    path = fit_json(tmp_path / "fit.json")
+    data = json.loads(path.read_text())
+    shift = {"p1.mass": -0.9, "fixed.mass": 0.8, "p1.length": 2e-3}
+    data["covariance"]["to_predicted_modes"] = [{"mode": "`p1.mass` at its tank mode's 0.4 kg",
+                                                 "move": shift}]
+    path.write_text(json.dumps(data))
+    fit = read_fit(path)
+    assert fit.draw_names == COV_NAMES
+    draws, acceptance = draw_parameters(fit, 40000, seed=5)
+    assert acceptance > 0.99
+    mean = np.array([1.5, 1.3, 0.05529, 0.00106]) + 0.5 * np.array(
+        [shift.get(n, 0.0) for n in COV_NAMES])
+    s = np.array([shift.get(n, 0.0) for n in COV_NAMES])
+    cov = COV + np.outer(s, s) / 4
+    sd = np.sqrt(np.diag(cov))
+    assert np.all(np.abs(draws.mean(axis=0) - mean) < SAMPLE_MOMENTS * sd)
+    assert np.all(np.abs(np.cov(draws.T) - cov) < SAMPLE_MOMENTS * np.outer(sd, sd))
+    fixed = draws[:, 0]
+    assert abs(np.mean(fixed > 1.9) - 0.5) < 0.01  # 1.5 and 2.3 kg, sd 0.01 kg each
+    # a record without the key draws exactly as before
+    plain = read_fit(fit_json(tmp_path / "plain.json"))
+    assert plain.to_modes == ()
+    bad = json.loads(path.read_text())
+    bad["covariance"]["to_predicted_modes"] = [{"mode": 3, "move": shift}]
+    path.write_text(json.dumps(bad))
+    with pytest.raises(ValueError, match=r"covariance.to_predicted_modes\[0\]`: expected an object "
+                                         r"with a \"mode\" string"):
+        read_fit(path)
+
+
+def test_an_estimate_held_on_a_bound_stays_there_when_another_bound_moves_it_through(tmp_path):
+    """Two estimates held at bounds (a spring at 0, a length on its band's upper edge): the
+    spring's move off its bound raises the length, which the band stops. The length stays on
+    its edge in every draw, instead of every draw being rejected."""
+    path = fit_json(tmp_path / "fit.json")
+    data = json.loads(path.read_text())
+    names = ["fixed.mass", "p1.mass", "p1.damping"]
+    keep = [COV_NAMES.index(n) for n in names]
+    data["covariance"] = {"parameters": names, "matrix": COV[np.ix_(keep, keep)].tolist(),
+                          "off_bounds": [{"bound": "p1.stiffness",
+                                          "move": {"p1.stiffness": 0.02, "p1.length": 4e-3}}]}
+    data["parameters"]["p1.stiffness"] |= {"estimated": True, "at_bound": "lower"}
+    data["parameters"]["p1.length"] |= {"value": 0.0684, "at_bound": "upper"}
+    path.write_text(json.dumps(data))
+    fit = read_fit(path)
+    draws, acceptance = draw_parameters(fit, 2000, seed=3)
+    assert acceptance > 0.99
+    assert np.all(draws[:, fit.draw_names.index("p1.length")] == 0.0684)
 
 
 def test_a_fit_record_keeps_the_moves_off_its_held_bounds_and_the_draws_reach_its_intervals(
