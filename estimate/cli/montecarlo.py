@@ -74,6 +74,10 @@ def run(args: argparse.Namespace) -> int:
               "record of an older version, or an estimate the data do not determine): the "
               "draws hold it at its value, so the envelope can be narrower than the fit's "
               "95 % intervals", file=sys.stderr)
+    for label, _ in fit.to_modes:
+        print(f"note: {args.fit}: half the draws are moved to the refit with {label} (a "
+              "pendulum far heavier than its tank mode: the record may not hold it), as the "
+              "fit's intervals reach", file=sys.stderr)
     case = load_case(args.case, strict=args.strict)
     exp = experiment(case, model_from_spec(args.model or fit.model_spec, case))
     with executor_for(args.scheduler, local=args.local, n_workers=args.workers) as ex:

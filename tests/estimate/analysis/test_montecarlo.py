@@ -323,6 +323,12 @@ def test_cli_montecarlo_says_the_draws_hold_an_estimate_at_its_bound(tmp_path, c
     assert "ended on a bound" not in capsys.readouterr().err
     mc = json.loads((tmp_path / "c" / "montecarlo.json").read_text())
     assert "p1.stiffness" in mc["parameters"]
+    data["covariance"]["to_predicted_modes"] = [{"mode": "`p1.mass` at its tank mode's 0.4 kg",
+                                                 "move": {"p1.mass": -0.9, "fixed.mass": 0.8}}]
+    fit.write_text(json.dumps(data))
+    assert main([*run, "--out", str(tmp_path / "d")]) == 0
+    assert ("half the draws are moved to the refit with `p1.mass` at its tank mode's 0.4 kg"
+            in capsys.readouterr().err)
 
 
 def test_cli_export_c_and_fmu(tmp_path, capsys):
