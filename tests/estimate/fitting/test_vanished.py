@@ -3,7 +3,14 @@ stops when its cost stalls with the mode's mass gone, and is refitted with its o
 parameters held.
 
 Before: a ``fixed,p1,p2`` fit of a one-mode record ran all 300 IPOPT iterations and ended
-"not converged" (17-39 s on 3,001 samples, 466 s on 30,001)."""
+"not converged" (17-39 s on 3,001 samples, 466 s on 30,001).
+
+The same fit's other failure: ``p2`` driven far below its frequency is a second fixed mass,
+takes the fixed mass's share (0.5-1.5 kg for its mode's 0.048 kg) and wanders in frequency
+until IPOPT runs out of iterations or diverges (seeds 2, 3, 4, 8, 13 of the record below:
+fixed mass 0.0001-0.99 kg for 1.5). Such a fit is refitted from its start with that
+pendulum's other parameters held (its damper at 0, as a vanished one's): the five then
+converge with the fixed mass within 0.5 % of the truth."""
 
 import warnings
 
@@ -68,25 +75,60 @@ def test_the_stall_rule(one_mode):
     assert first_stop(falling, [vanished] * 200) is None
 
 
+def _one_mode_record(folder, seed: int):
+    p = pendulum(1.30, 0.0553, 0.01)
+    f1 = ref.natural_frequency(p, G) / (2 * np.pi)
+    drive = ref.Ramped(ref.LinearSweep(0.001, 0.6 * f1, 1.6 * f1, 6.0), 1.5, 0.0)
+    case, _ = make_case(folder, "one_mode", drive, pendulums=[p], fixed_mass=1.5, dry_mass=1.2,
+                        noise=0.013, displacement_noise=2e-5, duration=6.0, rate=500.0,
+                        seed=seed, prediction=Prediction(1.338, 0.057, 1.456, 0.007))
+    return case
+
+
+@pytest.mark.slow  # 13 fits, 1-35 s each
+def test_a_mode_the_record_lacks_ends_held_and_the_intervals_hold_the_truth(tmp_path):
+    """``fixed,p1,p2`` on 13 draws of the one-mode record (seeds 1-13): p2's mass vanishes
+    (the fit stops and is refitted with its other parameters held), or takes the fixed
+    mass's share (refitted from the start with them held), or stays near its mode's mass.
+    Every fixed-mass interval holds the truth (measured: 13 of 13), at least 9 fits converge
+    (measured: 9; before the heavy-mass refit 4, the five heavy ones ending 0.0001-0.99 kg),
+    and every refit holds p2's length at its start and its damper at 0."""
+    converged, held = 0, 0
+    for seed in range(1, 14):
+        case = _one_mode_record(tmp_path / str(seed), seed)
+        problem = _problem(case, lag="none")
+        starts = {e.name: e.initial for e in problem.estimated}
+        res = fit(problem, progress=False)
+        converged += res.converged
+        lo, hi = res.interval("fixed.mass")
+        assert lo <= 1.5 <= hi, (seed, res.status, lo, hi)
+        if "p2.length" not in res.names:
+            held += 1
+            assert res.problem.fixed[0]["p2.length"] == pytest.approx(starts["p2.length"])
+            assert res.problem.fixed[0]["p2.damping"] == 0.0
+            assert res.converged, (seed, res.status)
+    assert converged >= 9 and held >= 5, (converged, held)
+
+
+@pytest.mark.slow  # the first solve diverges (196 iterations, 20 s) before the refit
 def test_a_vanished_mode_is_refitted_with_its_parameters_held(one_mode):
-    """``fixed,p1,p2`` on the one-mode record: p2's mass goes to zero, the fit stops and is
-    refitted with p2's length and spring held at their starts and its damper at 0. The
-    refit converges in a few dozen iterations in all (300 and "not converged" before); p2's
-    mass stays estimated, on its bound, with a one-sided limit under 2 % of the first
-    mode's (measured: 0.3 %); the intervals of the fixed mass, the first mode's mass and
-    length hold the truth."""
+    """``fixed,p1,p2`` on the one-mode record: p2's mass ends far from its mode's (here
+    0.51 kg, the first solve diverging), and the fit is refitted with p2's length and spring
+    held at their starts and its damper at 0. p2's mass stays estimated, on its bound, with
+    a one-sided limit under 2 % of the first mode's; the intervals of the fixed mass, the
+    first mode's mass and length hold the truth."""
     case, truth = one_mode
     problem = _problem(case, lag="none")
     starts = {e.name: e.initial for e in problem.estimated}
     res = fit(problem, progress=False)
-    assert res.converged and res.iterations <= 80, (res.status, res.iterations)
+    assert res.converged, (res.status, res.iterations)
     assert "p2.mass" in res.names
     for name in ("p2.length", "p2.damping", "p2.stiffness"):
         assert name not in res.names
     held = res.problem.fixed[0]
     assert held["p2.length"] == pytest.approx(starts["p2.length"])
     assert held["p2.damping"] == 0.0
-    note = next(n for n in res.problem.notes if "no such mode" in n)
+    note = next(n for n in res.problem.notes if "does not determine" in n)
     assert "p2.mass" in note and "p2.length" in note
     assert res.at_bound[res.names.index("p2.mass")] == "lower"
     assert res.one_sided_limit("p2.mass") < 0.02 * truth["p1.mass"]
@@ -107,3 +149,30 @@ def test_held_refit_needs_a_vanished_mass(one_mode):
     assert "p2.mass went to 1e-06" in note and "Stalled after 20 iterations" in note
     assert held.fixed[0]["p2.damping"] == 0.0
     assert "p1.length" in held.names and "p2.mass" in held.names
+
+
+def test_a_mass_far_above_its_mode_is_refitted_from_the_start_with_its_mode_held(one_mode):
+    """p2 at 0.9 kg (19 x its tank mode's 0.048 kg) after a fit that did not converge: held
+    like a vanished one (length and spring at their starts, damper at 0), and every estimate
+    restarted where the fit began; the note says how heavy it went and the status. At 2 x
+    its mode (under ``PREDICTION_FACTOR``) nothing is held."""
+    from estimate.fitting.initial import PREDICTION_FACTOR
+
+    problem = _problem(one_mode[0], lag="none")
+    theta = problem.initial.copy()
+    k = problem.names.index("p2.mass")
+    predicted = problem.estimated[k].initial
+    theta[k] = 2.0 * predicted
+    assert 2.0 < PREDICTION_FACTOR and held_refit(problem, theta, "Invalid_Number_Detected",
+                                                  196) is None
+    theta[k] = 0.9
+    theta[problem.names.index("fixed.mass")] = 0.5
+    held, note = held_refit(problem, theta, "Invalid_Number_Detected", 196)
+    assert "p2.length" not in held.names and "p2.stiffness" not in held.names
+    assert held.fixed[0]["p2.damping"] == 0.0
+    assert held.fixed[0]["p2.length"] == pytest.approx(problem.estimated[
+        problem.names.index("p2.length")].initial)
+    start = dict(zip(held.names, held.initial))
+    assert start["fixed.mass"] == pytest.approx(problem.initial[problem.names.index("fixed.mass")])
+    assert start["p2.mass"] == pytest.approx(predicted)
+    assert "p2.mass went to 0.9 kg" in note and "Invalid_Number_Detected after 196" in note
