@@ -50,6 +50,7 @@ Example
 
 from __future__ import annotations
 
+import math
 import os
 
 os.environ.setdefault("OMP_NUM_THREADS", "1")
@@ -381,6 +382,90 @@ class Ramped:
 
 
 # ----------------------------------------------------------------------------------------------
+# the drives at one time, for the integrator's right-hand side: the same formulas on floats
+# (NumPy on one-element arrays cost ~25 us a call, the half of every reference record's time);
+# ``test_reference_models`` checks them against the array forms above
+
+
+def _harmonic_at(a: float, da: float, dda: float, ph: float, dph: float, ddph: float
+                 ) -> tuple[float, float, float]:
+    s, c = math.sin(ph), math.cos(ph)
+    return (a * s, da * s + a * dph * c,
+            dda * s + 2.0 * da * dph * c + a * ddph * c - a * dph**2 * s)
+
+
+def _levels_at(t: float, levels: Sequence[float], dwell: float, ramp: float
+               ) -> tuple[float, float, float, float]:
+    val, d1, d2 = float(levels[0]), 0.0, 0.0
+    integral = val * t
+    for k in range(1, len(levels)):
+        jump = float(levels[k]) - float(levels[k - 1])
+        u = (t - k * dwell) / ramp
+        uc = min(max(u, 0.0), 1.0)
+        val += jump * (10 * uc**3 - 15 * uc**4 + 6 * uc**5)
+        if 0.0 < u < 1.0:
+            d1 += jump * (30 * uc**2 - 60 * uc**3 + 30 * uc**4) / ramp
+            d2 += jump * (60 * uc - 180 * uc**2 + 120 * uc**3) / ramp**2
+        integ = 0.0 if u <= 0.0 else (2.5 * uc**4 - 3 * uc**5 + uc**6 if u < 1.0 else 0.5 + (u - 1.0))
+        integral += jump * ramp * integ
+    return val, d1, d2, integral
+
+
+def drive_at(excitation: Excitation):
+    """``excitation`` at one time [s] as floats ``(x, xd, xdd)``, or None for a drive without
+    a float form (the integrator then calls it on a one-element array). A drive of another
+    module gives its own as an ``at(t)`` method."""
+    e = excitation
+    if hasattr(e, "at"):
+        return e.at
+    if isinstance(e, Sine):
+        w = 2.0 * math.pi * e.frequency
+        return lambda t: _harmonic_at(e.amplitude, 0.0, 0.0, w * t + e.phase, w, 0.0)
+    if isinstance(e, LinearSweep):
+        rate = (e.f_end - e.f_start) / e.duration
+
+        def sweep(t: float) -> tuple[float, float, float]:
+            tc = min(max(t, 0.0), e.duration)
+            cycles = e.f_start * tc + 0.5 * rate * tc**2
+            cycles += e.f_start * t if t < 0.0 else 0.0
+            cycles += e.f_end * (t - e.duration) if t > e.duration else 0.0
+            dfreq = rate if 0.0 <= t <= e.duration else 0.0
+            return _harmonic_at(e.amplitude, 0.0, 0.0, 2 * math.pi * cycles + e.phase,
+                                2 * math.pi * (e.f_start + rate * tc), 2 * math.pi * dfreq)
+        return sweep
+    if isinstance(e, SteppedSweep):
+        def stepped(t: float) -> tuple[float, float, float]:
+            f, df, _, cycles = _levels_at(t, e.frequencies, e.dwell, e.ramp)
+            return _harmonic_at(e.amplitude, 0.0, 0.0, 2 * math.pi * cycles + e.phase,
+                                2 * math.pi * f, 2 * math.pi * df)
+        return stepped
+    if isinstance(e, AmplitudeSteps):
+        w = 2.0 * math.pi * e.frequency
+
+        def steps(t: float) -> tuple[float, float, float]:
+            a, da, dda, _ = _levels_at(t, e.amplitudes, e.dwell, e.ramp)
+            return _harmonic_at(a, da, dda, w * t + e.phase, w, 0.0)
+        return steps
+    if isinstance(e, Ramped):
+        inner = drive_at(e.drive)
+        if inner is None:
+            return None
+
+        def ramped(t: float) -> tuple[float, float, float]:
+            x0, xd0, xdd0 = inner(t)
+            u = min(max((t - e.start) / e.duration, 0.0), 1.0)
+            s = 10 * u**3 - 15 * u**4 + 6 * u**5
+            if 0.0 < u < 1.0:
+                ds = (30 * u**2 - 60 * u**3 + 30 * u**4) / e.duration
+                dds = (60 * u - 180 * u**2 + 120 * u**3) / e.duration**2
+            else:
+                ds = dds = 0.0
+            return s * x0, ds * x0 + s * xd0, dds * x0 + 2 * ds * xd0 + s * xdd0
+        return ramped
+    return None
+
+
+# ----------------------------------------------------------------------------------------------
 # simulation
 
 
@@ -502,11 +587,15 @@ def simulate_lateral(
     one = np.empty(1)
 
     plain = all(p.cubic_stiffness == 0 and p.coulomb == 0 and p.extra is None for p in pend)
+    at_time = drive_at(excitation)
 
     def rhs(time: float, y: Array) -> Array:
         # the same equation as _pendulum_accel, vectorised over the pendulums for speed
-        one[0] = time
-        xdd = excitation(one)[2][0]
+        if at_time is not None:
+            xdd = at_time(time)[2]
+        else:
+            one[0] = time
+            xdd = excitation(one)[2][0]
         th, thd = y[:n_p], y[n_p:]
         torque = m * L * xdd * np.cos(th) + m * gravity * L * np.sin(th)
         if plain:

@@ -59,6 +59,13 @@ class TransportMove:
         dds = (420 * u**2 - 1680 * u**3 + 2100 * u**4 - 840 * u**5) / T**2
         return D * s, D * ds, D * dds
 
+    def at(self, t: float) -> tuple[float, float, float]:
+        """:meth:`__call__` at one time [s], on floats (the integrator's right-hand side)."""
+        u, T, D = min(max((t - self.start) / self.duration, 0.0), 1.0), self.duration, self.distance
+        return (D * (35 * u**4 - 84 * u**5 + 70 * u**6 - 20 * u**7),
+                D * (140 * u**3 - 420 * u**4 + 420 * u**5 - 140 * u**6) / T,
+                D * (420 * u**2 - 1680 * u**3 + 2100 * u**4 - 840 * u**5) / T**2)
+
     def window(self, t: ArrayLike) -> tuple[Array, Array, Array]:
         """A smooth bump ``w = 64 u^3 (1 - u)^3`` over the move (0 outside, 1 at mid-move,
         C2 at both ends) and its two time derivatives: where servo ripple lives."""
@@ -92,6 +99,23 @@ class ServoFollow:
             x = x + a * w * s
             xd = xd + a * (dw * s + w * om * c)
             xdd = xdd + a * (ddw * s + 2 * dw * om * c - w * om**2 * s)
+        return x, xd, xdd
+
+    def at(self, t: float) -> tuple[float, float, float]:
+        """:meth:`__call__` at one time [s], on floats (the integrator's right-hand side)."""
+        tt = t - self.lag
+        x, xd, xdd = self.command.at(tt)
+        if self.ripple:
+            u, T = min(max((tt - self.command.start) / self.command.duration, 0.0), 1.0), \
+                self.command.duration
+            w = 64 * u**3 * (1 - u) ** 3
+            dw = 192 * u**2 * (1 - u) ** 2 * (1 - 2 * u) / T
+            ddw = 384 * u * (1 - u) * ((1 - 2 * u) ** 2 - u * (1 - u)) / T**2
+            om = 2 * math.pi * self.ripple_frequency
+            s, c, a = math.sin(om * tt), math.cos(om * tt), self.ripple
+            x += a * w * s
+            xd += a * (dw * s + w * om * c)
+            xdd += a * (ddw * s + 2 * dw * om * c - w * om**2 * s)
         return x, xd, xdd
 
 

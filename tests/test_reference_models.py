@@ -17,9 +17,11 @@ from reference_models import (
     Friction,
     LinearSweep,
     Pendulum,
+    Ramped,
     Sine,
     SteppedSweep,
     Tone,
+    drive_at,
     hinge_damping,
     natural_frequency,
     simulate_lateral,
@@ -109,6 +111,43 @@ def test_excitation_derivatives_are_consistent(excitation) -> None:
     scale_a = np.max(np.abs(xdd))
     np.testing.assert_allclose((xp - xm) / (2 * h), xd, atol=1e-6 * scale_v)
     np.testing.assert_allclose((xdp - xdm) / (2 * h), xdd, atol=1e-5 * scale_a)
+
+
+@pytest.mark.parametrize(
+    "excitation",
+    [
+        Sine(0.005, 1.855, 0.3),
+        LinearSweep(0.002, 1.0, 4.0, 30.0, 0.2),
+        SteppedSweep(0.005, (1.0, 2.0, 3.0, 4.0, 5.0), dwell=6.0, ramp=0.5),
+        AmplitudeSteps((0.002, 0.004, 0.008), 2.0, dwell=10.0, ramp=0.5),
+        Ramped(AmplitudeSteps((0.002, 0.004), 2.0, dwell=10.0, ramp=0.5), 1.5, start=0.7),
+        Ramped(LinearSweep(0.002, 1.0, 4.0, 30.0), 2.0),
+    ],
+)
+def test_the_integrators_float_form_of_each_drive_is_its_array_form(excitation) -> None:
+    """``drive_at`` (the right-hand side's float formulas) against the array forms, before,
+    inside and after every ramp and step, to 1e-12 of each signal's peak (rounding: the
+    same formulas, ``math`` for NumPy)."""
+    at = drive_at(excitation)
+    assert at is not None
+    t = np.sort(np.r_[np.random.default_rng(1).uniform(-1.0, 31.0, 3000), 0.0, 0.7, 2.2, 30.0])
+    arrays = excitation(t)
+    floats = np.array([at(float(ti)) for ti in t]).T
+    for a, f in zip(arrays, floats):
+        np.testing.assert_allclose(f, a, rtol=0, atol=1e-12 * np.max(np.abs(a)))
+    assert drive_at(Crank(0.01, 0.15, 1.855)) is None  # the array form, one element a call
+
+
+def test_a_servo_following_a_transport_move_has_its_float_form() -> None:
+    """``ServoFollow.at`` (lag, ripple while moving) against its array form, as above."""
+    from reference_rig_records import ServoFollow, TransportMove
+
+    servo = ServoFollow(TransportMove(0.3, 2.5, start=1.0), lag=0.015, ripple=2e-5)
+    t = np.linspace(0.0, 5.0, 2001) + 1e-4
+    arrays = servo(t)
+    floats = np.array([drive_at(servo)(float(ti)) for ti in t]).T
+    for a, f in zip(arrays, floats):
+        np.testing.assert_allclose(f, a, rtol=0, atol=1e-12 * np.max(np.abs(a)))
 
 
 def test_stiff_hinge_limit_is_rigid() -> None:
