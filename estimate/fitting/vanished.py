@@ -131,41 +131,24 @@ def held_refit(problem: FitProblem, values: Sequence[float], status: str, iterat
     theta = np.asarray(values, float)
     masses = _components(problem)
     gone = _vanished(problem, theta, masses)
-    if not gone:
-        return _heavy_refit(problem, theta, masses, status, iterations)
+    heavy = [] if gone else _too_heavy(problem, theta, masses)
+    if not gone and not heavy:
+        return None
     est = problem.estimated
     held, parts = problem, []
-    for j in gone:
+    for j in gone or heavy:
         others = [est[k] for k in masses[j]]
         values_held = [held_value(e.name, e.initial) for e in others]
         for e, v in zip(others, values_held):
             held = held.holding(e.name, v)
         kept = ", ".join(f"{e.name} (held at {v:.4g})" for e, v in zip(others, values_held))
         parts.append(f"{est[j].name} went to {theta[j]:.3g} (its start {est[j].initial:.4g}): "
-                     f"the record shows no such mode and does not determine {kept}")
+                     f"the record shows no such mode and does not determine {kept}" if gone
+                     else f"{est[j].name} went to {theta[j]:.3g} kg, over {PREDICTION_FACTOR:g} "
+                     f"x its tank mode's: the record does not determine {kept}")
+    note = "; ".join(parts) + f". The fit did not converge ({status} after {iterations} iterations)"
+    if heavy:  # the estimates it reached are the far mass's: every one starts anew
+        return held, note + " and was refitted from its start with those held; the masses stay estimated."
     start = {e.name: float(v) for e, v in zip(est, theta)}
-    note = ("; ".join(parts) + f". The fit did not converge ({status} after {iterations} "
-            "iterations) and was refitted with those held; the masses stay estimated.")
-    return held.with_initial(start), note
-
-
-def _heavy_refit(problem: FitProblem, theta: np.ndarray, masses, status: str, iterations: int
-                 ) -> tuple[FitProblem, str] | None:
-    heavy = _too_heavy(problem, theta, masses)
-    if not heavy:
-        return None
-    est = problem.estimated
-    held, parts = problem, []
-    for j in heavy:
-        others = [est[k] for k in masses[j]]
-        values_held = [held_value(e.name, e.initial) for e in others]
-        for e, v in zip(others, values_held):
-            held = held.holding(e.name, v)
-        kept = ", ".join(f"{e.name} (held at {v:.4g})" for e, v in zip(others, values_held))
-        parts.append(f"{est[j].name} went to {theta[j]:.3g} kg, over "
-                     f"{PREDICTION_FACTOR:g} x its tank mode's: the record does not determine "
-                     f"{kept}")
-    note = ("; ".join(parts) + f". The fit did not converge ({status} after {iterations} "
-            "iterations) and was refitted from its start with those held; the masses stay "
-            "estimated.")
-    return held, note
+    return held.with_initial(start), note + (" and was refitted with those held; the masses "
+                                             "stay estimated.")
