@@ -44,8 +44,8 @@ def draw_parameters(fit: Fit, samples: int, *, seed: int | None = 0,
     their bounds: ``mean + L z + sum_k |z_k| move_k + sum_j u_j shift_j`` (``L L^T`` the
     covariance, ``move_k`` the estimates' move off the ``k``-th bound per standard
     deviation, ``shift_j`` their move with the ``j``-th conflicting mode at its prediction,
-    ``u_j`` 0 or 1 with equal odds); the estimates held on a bound stay on it when a move pushes
-    them through it.
+    ``u_j`` 0 or 1 with equal odds); the estimates held on a bound stay on it when a move
+    pushes them through it.
 
     Returns
     -------

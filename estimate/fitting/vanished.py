@@ -31,7 +31,9 @@ from collections.abc import Callable, Sequence
 
 import numpy as np
 
-from .initial import PREDICTION_FACTOR
+from analogs.errors import InputError
+
+from .initial import PREDICTION_FACTOR, predicted_values
 from .problem import FitProblem
 
 __all__ = ["HELD_STATUSES", "STALLED", "STALL_ITERATIONS", "STALL_WINDOW", "VANISHED_SHARE",
@@ -100,10 +102,6 @@ def held_value(name: str, start: float) -> float:
 def _too_heavy(problem: FitProblem, theta: np.ndarray, masses) -> list[int]:
     """The pendulum masses above ``PREDICTION_FACTOR`` times their tank mode's prediction
     (:mod:`estimate.fitting.mode_conflicts`)."""
-    from analogs.errors import InputError
-
-    from .initial import predicted_values
-
     try:
         predicted = predicted_values(problem.experiments[0].case, problem.model)
     except (InputError, ValueError, ArithmeticError, IndexError):
