@@ -394,6 +394,17 @@ def _harmonic_at(a: float, da: float, dda: float, ph: float, dph: float, ddph: f
             dda * s + 2.0 * da * dph * c + a * ddph * c - a * dph**2 * s)
 
 
+def _smoothstep_at(u: float, duration: float) -> tuple[float, float, float]:
+    """The quintic smoothstep at ``u`` (clipped to [0, 1]) and its time derivatives for a
+    ramp of ``duration`` [s]."""
+    uc = min(max(u, 0.0), 1.0)
+    s = 10 * uc**3 - 15 * uc**4 + 6 * uc**5
+    if not 0.0 < u < 1.0:
+        return s, 0.0, 0.0
+    return (s, (30 * uc**2 - 60 * uc**3 + 30 * uc**4) / duration,
+            (60 * uc - 180 * uc**2 + 120 * uc**3) / duration**2)
+
+
 def _levels_at(t: float, levels: Sequence[float], dwell: float, ramp: float
                ) -> tuple[float, float, float, float]:
     val, d1, d2 = float(levels[0]), 0.0, 0.0
@@ -402,10 +413,8 @@ def _levels_at(t: float, levels: Sequence[float], dwell: float, ramp: float
         jump = float(levels[k]) - float(levels[k - 1])
         u = (t - k * dwell) / ramp
         uc = min(max(u, 0.0), 1.0)
-        val += jump * (10 * uc**3 - 15 * uc**4 + 6 * uc**5)
-        if 0.0 < u < 1.0:
-            d1 += jump * (30 * uc**2 - 60 * uc**3 + 30 * uc**4) / ramp
-            d2 += jump * (60 * uc - 180 * uc**2 + 120 * uc**3) / ramp**2
+        s, ds, dds = _smoothstep_at(u, ramp)
+        val, d1, d2 = val + jump * s, d1 + jump * ds, d2 + jump * dds
         integ = 0.0 if u <= 0.0 else (2.5 * uc**4 - 3 * uc**5 + uc**6 if u < 1.0 else 0.5 + (u - 1.0))
         integral += jump * ramp * integ
     return val, d1, d2, integral
@@ -453,13 +462,7 @@ def drive_at(excitation: Excitation):
 
         def ramped(t: float) -> tuple[float, float, float]:
             x0, xd0, xdd0 = inner(t)
-            u = min(max((t - e.start) / e.duration, 0.0), 1.0)
-            s = 10 * u**3 - 15 * u**4 + 6 * u**5
-            if 0.0 < u < 1.0:
-                ds = (30 * u**2 - 60 * u**3 + 30 * u**4) / e.duration
-                dds = (60 * u - 180 * u**2 + 120 * u**3) / e.duration**2
-            else:
-                ds = dds = 0.0
+            s, ds, dds = _smoothstep_at((t - e.start) / e.duration, e.duration)
             return s * x0, ds * x0 + s * xd0, dds * x0 + 2 * ds * xd0 + s * xdd0
         return ramped
     return None

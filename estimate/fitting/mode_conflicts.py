@@ -27,7 +27,7 @@ from analogs.errors import InputError
 
 from .initial import PREDICTION_FACTOR, predicted_values
 
-__all__ = ["ModeConflict", "mode_conflicts"]
+__all__ = ["ModeConflict", "mode_conflicts", "mode_masses"]
 
 #: Correlations at least this strong (in size) are named as moving with the mode.
 STRONG = 0.7
@@ -58,6 +58,27 @@ class ModeConflict:
         return out
 
 
+def mode_masses(problem) -> dict[int, tuple[str, float, float]]:
+    """Per estimated pendulum mass of ``problem`` (its index among the estimates): the
+    component ``pN``, and the tank's predicted mass [kg] and length [m] of mode N. Empty
+    when the tank has no prediction."""
+    if not problem.experiments:
+        return {}
+    try:
+        predicted = predicted_values(problem.experiments[0].case, problem.model)
+    except (InputError, ValueError, ArithmeticError):
+        return {}
+    out = {}
+    for i, e in enumerate(problem.estimated):
+        comp, local = e.parameter.split(".", 1) if "." in e.parameter else ("", "")
+        if local != "mass" or not (comp.startswith("p") and comp[1:].isdigit()):
+            continue
+        m_pred, L_pred = predicted.get(f"{comp}.mass"), predicted.get(f"{comp}.length")
+        if m_pred and L_pred and m_pred > 0:
+            out[i] = (comp, float(m_pred), float(L_pred))
+    return out
+
+
 def mode_conflicts(problem, theta: np.ndarray, stderr: np.ndarray, cov: np.ndarray,
                    derived: dict[str, float]) -> list[ModeConflict]:
     """The estimated pendulum masses of ``problem`` (values ``theta``, standard errors
@@ -65,24 +86,14 @@ def mode_conflicts(problem, theta: np.ndarray, stderr: np.ndarray, cov: np.ndarr
     prediction of their mode, with a warning for those above it by more than two standard
     errors; ``derived`` holds the fitted ``pN.frequency_hz``. Empty when the tank has no
     prediction. A mass at a bound (no standard error) is left out."""
-    if not problem.experiments:
+    modes = mode_masses(problem)
+    if not modes:
         return []
-    case = problem.experiments[0].case
-    try:
-        predicted = predicted_values(case, problem.model)
-    except (InputError, ValueError, ArithmeticError):
-        return []
-    g = case.rig.gravity
+    g = problem.experiments[0].case.rig.gravity
     names = [e.name for e in problem.estimated]
     d = np.sqrt(np.clip(np.diag(cov), 0, None))
     out = []
-    for i, e in enumerate(problem.estimated):
-        comp, local = e.parameter.split(".", 1) if "." in e.parameter else ("", "")
-        if local != "mass" or not (comp.startswith("p") and comp[1:].isdigit()):
-            continue
-        m_pred, L_pred = predicted.get(f"{comp}.mass"), predicted.get(f"{comp}.length")
-        if not m_pred or not L_pred or m_pred <= 0:
-            continue
+    for i, (comp, m_pred, L_pred) in modes.items():
         m, se = float(theta[i]), float(stderr[i])
         if not (math.isfinite(se) and m > PREDICTION_FACTOR * m_pred):
             continue

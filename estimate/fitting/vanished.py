@@ -31,9 +31,8 @@ from collections.abc import Callable, Sequence
 
 import numpy as np
 
-from analogs.errors import InputError
-
-from .initial import PREDICTION_FACTOR, predicted_values
+from .initial import PREDICTION_FACTOR
+from .mode_conflicts import mode_masses
 from .problem import FitProblem
 
 __all__ = ["HELD_STATUSES", "STALLED", "STALL_ITERATIONS", "STALL_WINDOW", "VANISHED_SHARE",
@@ -102,18 +101,8 @@ def held_value(name: str, start: float) -> float:
 def _too_heavy(problem: FitProblem, theta: np.ndarray, masses) -> list[int]:
     """The pendulum masses above ``PREDICTION_FACTOR`` times their tank mode's prediction
     (:mod:`estimate.fitting.mode_conflicts`)."""
-    try:
-        predicted = predicted_values(problem.experiments[0].case, problem.model)
-    except (InputError, ValueError, ArithmeticError, IndexError):
-        return []
-    est = problem.estimated
-    out = []
-    for j in masses:
-        comp = est[j].name.split(".", 1)[0]
-        m = predicted.get(f"{comp}.mass")
-        if comp[:1] == "p" and comp[1:].isdigit() and m and theta[j] > PREDICTION_FACTOR * m:
-            out.append(j)
-    return out
+    modes = mode_masses(problem)
+    return [j for j in masses if j in modes and theta[j] > PREDICTION_FACTOR * modes[j][1]]
 
 
 def held_refit(problem: FitProblem, values: Sequence[float], status: str, iterations: int
