@@ -213,3 +213,50 @@ def test_the_fixed_mass_is_covered_when_a_mode_the_record_lacks_is_fitted(tmp_pa
         spurious += bool(res.mode_shifts)
     print(f"\nfixed mass covered {hits} of 12; p2 above 3x its prediction in {spurious}")
     assert hits >= 9, (hits, spurious)
+
+
+@pytest.mark.slow
+def test_intervals_cover_an_unweighed_container_through_a_transducer_with_large_swings(
+        tmp_path):
+    """Several hardware effects at once: 20 s at 500 Hz from rest, a 1.5 mm downward sweep
+    1.5 -> 0.7 f1 faded in over 1.5 s (the pendulum swings to 0.52 rad through resonance),
+    the force through the six-axis transducer's model (coloured noise, lines, low-pass,
+    quantisation) 20 ms behind the displacement, and the container not weighed
+    (``dry_mass = "estimate"``: only the liquid mass is known). ``fixed,p1`` with the lag
+    estimated; 12 draws. Each 95 % interval of the dry mass, the slosh mass and the
+    pendulum length covers the truth at least 10 times of 12 (below 10 with probability 2 %
+    at 95 %). Measured: 12 of 12 each (seeds 300-311, and 1-12 while writing the test); the
+    Gauss-Newton intervals alone (white residuals assumed) cover 7, 5 and 11 of 12."""
+    import reference_rig_records as rr
+
+    from estimate import load_case
+
+    p = pendulum(1.30, 0.0553, 0.01)
+    f1 = ref.natural_frequency(p, 9.80665) / (2 * np.pi)
+    liquid = 2.842  # kg: the 8-inch sphere at 60 % (make_case's tank), split as below
+    truth = {"rig.dry_mass": 1.2, "p1.mass": p.mass, "p1.length": p.length}
+    hits = dict.fromkeys(truth, 0)
+    for seed in range(300, 312):
+        drive = ref.Ramped(ref.LinearSweep(0.0015, 1.5 * f1, 0.7 * f1, 20.0), 1.5, 0.0)
+        case, sim = make_case(tmp_path, f"U{seed}", drive, pendulums=[p],
+                              fixed_mass=liquid - p.mass, dry_mass=1.2, duration=20.0,
+                              rate=500.0, seed=seed, noise=0.0, sensor_delay=0.02)
+        force = rr.force_sensor(sim["time"], sim["force"], rng=np.random.default_rng(seed),
+                                offset=0.0)
+        csv = tmp_path / f"U{seed}.csv"
+        data = np.loadtxt(csv, delimiter=",", skiprows=1)
+        data[:, 2] = force
+        np.savetxt(csv, data, delimiter=",", header="time,displacement,force", comments="",
+                   fmt="%.12g")
+        toml = tmp_path / f"U{seed}.toml"
+        text = toml.read_text()
+        assert "dry_mass = 1.2" in text
+        toml.write_text(text.replace("dry_mass = 1.2", 'dry_mass = "estimate"'))
+        case = load_case(toml)
+        res = fit(FitProblem.build(case, model_from_spec("fixed,p1", case)), progress=False)
+        assert res.converged, (seed, res.status)
+        for k, v in truth.items():
+            lo, hi = res.interval(k)
+            hits[k] += lo <= v <= hi
+    print(f"\ncovered {hits} of 12")  # the counts, with -s
+    assert all(h >= 10 for h in hits.values()), hits
