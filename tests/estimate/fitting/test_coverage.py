@@ -149,6 +149,19 @@ def test_intervals_cover_a_weak_spring_the_fit_may_hold_at_zero(tmp_path):
     assert all(h >= 34 for h in hits.values()), hits
 
 
+def _through_transducer(csv, sim, seed: int) -> None:
+    """Replace the force column of ``csv`` by what the six-axis transducer's model records
+    of the simulated force (``reference_rig_records.force_sensor``, no offset)."""
+    import reference_rig_records as rr
+
+    force = rr.force_sensor(sim["time"], sim["force"], rng=np.random.default_rng(seed),
+                            offset=0.0)
+    data = np.loadtxt(csv, delimiter=",", skiprows=1)
+    data[:, 2] = force
+    np.savetxt(csv, data, delimiter=",", header="time,displacement,force", comments="",
+               fmt="%.12g")
+
+
 @pytest.mark.slow
 def test_intervals_cover_the_masses_of_long_sine_records_through_a_transducer(tmp_path):
     """60 s at 500 Hz from rest, a 2 mm sine at 0.9 f1, the force through a six-axis
@@ -160,8 +173,6 @@ def test_intervals_cover_the_masses_of_long_sine_records_through_a_transducer(tm
     32 and 33 of 41 such draws (z-scores' spread 1.48). Now each mass's 95 % interval covers
     the truth at least 26 times of 30 (below 26 with probability 2 % at 95 %) and the
     z-scores spread by at most 1.25."""
-    import reference_rig_records as rr
-
     from estimate import load_case
 
     p = pendulum()
@@ -174,13 +185,7 @@ def test_intervals_cover_the_masses_of_long_sine_records_through_a_transducer(tm
         drive = ref.Ramped(ref.Sine(0.002, 0.9 * f1), 1.0, 0.0)
         case, sim = make_case(tmp_path, f"L{seed}", drive, pendulums=[p], duration=60.0,
                               rate=500.0, seed=seed, noise=0.0, sensor_delay=0.015)
-        force = rr.force_sensor(sim["time"], sim["force"], rng=np.random.default_rng(seed),
-                                offset=0.0)
-        csv = tmp_path / f"L{seed}.csv"
-        data = np.loadtxt(csv, delimiter=",", skiprows=1)
-        data[:, 2] = force
-        np.savetxt(csv, data, delimiter=",", header="time,displacement,force", comments="",
-                   fmt="%.12g")
+        _through_transducer(tmp_path / f"L{seed}.csv", sim, seed)
         res = fit(FitProblem.build(load_case(tmp_path / f"L{seed}.toml"),
                                    model_from_spec("fixed,p1", case)), progress=False)
         for k, v in truth.items():
@@ -227,8 +232,6 @@ def test_intervals_cover_an_unweighed_container_through_a_transducer_with_large_
     pendulum length covers the truth at least 10 times of 12 (below 10 with probability 2 %
     at 95 %). Measured: 12 of 12 each (seeds 300-311, and 1-12 while writing the test); the
     Gauss-Newton intervals alone (white residuals assumed) cover 7, 5 and 11 of 12."""
-    import reference_rig_records as rr
-
     from estimate import load_case
 
     p = pendulum(1.30, 0.0553, 0.01)
@@ -241,13 +244,7 @@ def test_intervals_cover_an_unweighed_container_through_a_transducer_with_large_
         case, sim = make_case(tmp_path, f"U{seed}", drive, pendulums=[p],
                               fixed_mass=liquid - p.mass, dry_mass=1.2, duration=20.0,
                               rate=500.0, seed=seed, noise=0.0, sensor_delay=0.02)
-        force = rr.force_sensor(sim["time"], sim["force"], rng=np.random.default_rng(seed),
-                                offset=0.0)
-        csv = tmp_path / f"U{seed}.csv"
-        data = np.loadtxt(csv, delimiter=",", skiprows=1)
-        data[:, 2] = force
-        np.savetxt(csv, data, delimiter=",", header="time,displacement,force", comments="",
-                   fmt="%.12g")
+        _through_transducer(tmp_path / f"U{seed}.csv", sim, seed)
         toml = tmp_path / f"U{seed}.toml"
         text = toml.read_text()
         assert "dry_mass = 1.2" in text
