@@ -76,7 +76,8 @@ def _python_only(text: str) -> bool:
 
 def read_csv(path: Path, excitation: str | None, problems: list[str],
               rig_kind: str | None = "lateral", *, uniform: bool = True,
-              motion: Mapping[str, str] | None = None) -> tuple[Any, ...] | None:
+              motion: Mapping[str, str] | None = None, decimate: int = 1
+              ) -> tuple[Any, ...] | None:
     """Read and check the CSV; append problems; return (time, displacement, force, columns)
     or None (``columns``: the non-time columns of a spinning-rig CSV or of a six-axis record,
     else empty). ``motion``: the motion columns a six-axis record's ``[rig.motion]`` names
@@ -85,18 +86,22 @@ def read_csv(path: Path, excitation: str | None, problems: list[str],
     The file is streamed: a record with more samples than the memory budget allows
     (:mod:`estimate.data.budget`) is refused before its arrays are allocated. A UTF-8 byte
     order mark (Excel's "CSV UTF-8") is accepted. ``uniform=False`` accepts a time column
-    that is not uniform (``[test] resample_hz``).
+    that is not uniform (``[test] resample_hz``). A record the fit decimates by ``decimate``
+    (``[test] decimate``) may hold that many times more samples.
     """
     name = path.name
+    limit = max_samples() * decimate
     try:
         n_lines, ended = _count_lines(path)
-        if n_lines - 1 > max_samples():
-            problems.append(f"{name}: rows: {n_lines - 1} samples; {decimation_hint(n_lines - 1)}")
+        if n_lines - 1 > limit:
+            problems.append(f"{name}: rows: {n_lines - 1} samples; "
+                            f"{decimation_hint(n_lines - 1, decimate)}")
             return None
         with io.TextIOWrapper(open_input(path, "a CSV file"), newline="",
                               encoding="utf-8-sig") as fh:
             return _read_rows(csv.reader(fh), n_lines, name, excitation, problems, rig_kind,
-                              ended=ended, uniform=uniform, motion=motion)
+                              ended=ended, uniform=uniform, motion=motion, limit=limit,
+                              decimate=decimate)
     except InputError as exc:  # replaced by a pipe or a device since it was checked
         problems.append(f"{name}: {str(exc).split(': ', 1)[-1]}")
         return None
@@ -116,7 +121,8 @@ def _rows(reader) -> Iterator[tuple[int, list[str]]]:
 
 def _read_rows(reader, n_lines: int, name: str, excitation: str | None, problems: list[str],
                rig_kind: str | None, *, ended: bool = True, uniform: bool = True,
-               motion: Mapping[str, str] | None = None) -> tuple[Any, ...] | None:
+               motion: Mapping[str, str] | None = None, limit: int, decimate: int = 1
+               ) -> tuple[Any, ...] | None:
     rows = _rows(reader)
     first = next(rows, None)
     # a six-axis record reads like a spinning-rig one: named columns, all kept
@@ -170,7 +176,6 @@ def _read_rows(reader, n_lines: int, name: str, excitation: str | None, problems
             "use `excitation = \"crank\"` with a `[rig.crank]` table otherwise)")
 
     ncol = len(names)
-    limit = max_samples()
     data = np.full((min(max(n_lines - 1, 16), limit), ncol), np.nan)
     lines = np.empty(data.shape[0], dtype=int)
     bad_fields: list[str] = []
@@ -183,7 +188,7 @@ def _read_rows(reader, n_lines: int, name: str, excitation: str | None, problems
         if i == data.shape[0]:  # mixed line ends: more rows than counted
             if i >= limit:
                 problems.append(f"{name}: rows: more than {limit} samples; "
-                                f"{decimation_hint(limit + 1)}")
+                                f"{decimation_hint(limit + 1, decimate)}")
                 return None
             grow = min(2 * i, limit)
             data = np.vstack([data, np.full((grow - i, ncol), np.nan)])

@@ -52,6 +52,14 @@ def _read_test(ck: Checker, doc: Mapping[str, Any]) -> TestInfo | None:
         if key in t:
             rates[key] = ck.number(t, "test", key, unit="Hz", positive=True)
             bad_rest = bad_rest or rates[key] is None
+    if "decimate" in t:
+        factor = t["decimate"]
+        if isinstance(factor, bool) or not isinstance(factor, int) or factor < 1:
+            ck.add("[test] decimate", "expected an integer >= 1 (keep every k-th sample after "
+                   f"an anti-alias low-pass), found {type_name(factor)} `{factor!r}`")
+            bad_rest = True
+        else:
+            rates["decimate"] = factor
     if data is not None and not data.strip():
         ck.add("[test] data", 'expected a CSV path, found an empty string ""')
         data = None

@@ -77,8 +77,9 @@ def check_fit(cases: list[tuple[str, int, int]]) -> None:
                       f"({size_text(fit_bytes(n, c))})" for name, n, c in cases)
     raise InputError(f"the fit needs about {size_text(need)} ({parts}), over the memory budget "
                      f"of {size_text(budget)} (set {BUDGET_VARIABLE} to change it): decimate by "
-                     f"{factor} (low-pass below the new Nyquist frequency, then keep every "
-                     f"{factor}{_ordinal(factor)} row), cut the records or fit fewer channels")
+                     f"{factor} (a case's `[test] decimate = {factor}` low-passes its record "
+                     f"below the new Nyquist frequency and keeps every {factor}{_ordinal(factor)} "
+                     "row), cut the records or fit fewer channels")
 
 
 def size_text(n_bytes: float) -> str:
@@ -90,15 +91,18 @@ def size_text(n_bytes: float) -> str:
     return f"{n_bytes:.0f} B"
 
 
-def decimation_hint(samples: int) -> str:
-    """What to do with a record of ``samples`` samples over the budget."""
+def decimation_hint(samples: int, decimate: int = 1) -> str:
+    """What to do with a record of ``samples`` samples over the budget (``decimate``: the
+    ``[test] decimate`` it is read with)."""
     limit = max_samples()
     factor = math.ceil(samples / limit)
+    now = f" (now {decimate})" if decimate > 1 else ""
     return (f"a fit needs about {size_text(FIT_BYTES_PER_SAMPLE)} per sample "
-            f"({size_text(samples * FIT_BYTES_PER_SAMPLE)}), over the memory budget of "
-            f"{size_text(memory_budget())} (at most {limit} samples; set {BUDGET_VARIABLE} to "
-            f"change it): decimate by {factor} (low-pass below the new Nyquist frequency, then "
-            f"keep every {factor}{_ordinal(factor)} row) or cut the record")
+            f"({size_text(samples / decimate * FIT_BYTES_PER_SAMPLE)}), over the memory budget "
+            f"of {size_text(memory_budget())} (at most {limit} samples; set {BUDGET_VARIABLE} "
+            f"to change it): decimate by {factor}: `[test] decimate = {factor}`{now} low-passes "
+            f"the record below the new Nyquist frequency and keeps every "
+            f"{factor}{_ordinal(factor)} row; or cut the record")
 
 
 def _ordinal(n: int) -> str:

@@ -41,6 +41,9 @@ class TestInfo:
     resample_hz : float or None
         ``[test] resample_hz``: the timestamps need not be uniform; the record is brought
         onto a uniform time base at this rate [Hz] (:mod:`estimate.data.timebase`).
+    decimate : int or None
+        ``[test] decimate``: the record is low-passed and every ``decimate``-th sample kept
+        for the fit (:mod:`estimate.data.decimation`); ``None`` (absent): all samples.
     motion_band_hz : float or None
         ``[test] motion_band_hz``: the highest frequency of the carriage motion [Hz],
         which sets the displacement filter's cutoff (filtered input) and the carriage
@@ -59,6 +62,7 @@ class TestInfo:
     initial_state: str | None = None
     resample_hz: float | None = None
     motion_band_hz: float | None = None
+    decimate: int | None = None
 
 
 @dataclass(frozen=True)

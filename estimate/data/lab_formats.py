@@ -222,8 +222,8 @@ def _listing(names: list[str]) -> str:
 
 def read_lab(path: Path, toml_name: str, doc: Mapping[str, Any], excitation: str | None,
              rig_kind: str | None, rig: Rig | None, problems: list[str], *,
-             uniform: bool = True, unitless: dict[str, str] | None = None
-             ) -> tuple[Any, ...] | None:
+             uniform: bool = True, unitless: dict[str, str] | None = None,
+             decimate: int = 1) -> tuple[Any, ...] | None:
     """Read the channels ``[data.columns]`` of the case document ``doc`` names from the lab
     file ``path``; append problems; return ``(time, displacement, force, columns)`` as
     :func:`estimate.data._csv.read_csv` does, or None (``uniform=False``: the time need not
@@ -262,7 +262,7 @@ def read_lab(path: Path, toml_name: str, doc: Mapping[str, Any], excitation: str
             return None
         try:
             out = _read_channels(name, fmt, wanted, channels, listing, rig_kind, rig, problems,
-                                 n_before, uniform, unitless)
+                                 n_before, uniform, unitless, decimate)
         except Exception as exc:  # noqa: BLE001 - a library failing inside a damaged file
             del problems[n_before:]
             problems.append(f"{name}: not a readable {fmt} file (damaged: reading its channels "
@@ -279,7 +279,8 @@ def read_lab(path: Path, toml_name: str, doc: Mapping[str, Any], excitation: str
 def _read_channels(name: str, fmt: str, wanted: dict[str, _Spec], channels: dict[str, _Channel],
                    listing: list[str], rig_kind: str | None, rig: Rig | None,
                    problems: list[str], n_before: int, uniform: bool = True,
-                   unitless: dict[str, str] | None = None) -> tuple[Any, ...] | None:
+                   unitless: dict[str, str] | None = None, decimate: int = 1
+                   ) -> tuple[Any, ...] | None:
     def key(spec: _Spec) -> str:
         return (f"[data.columns] {spec.column}" if spec.explicit else
                 f"column `{spec.column}`, looked up by name without [data.columns]")
@@ -305,7 +306,7 @@ def _read_channels(name: str, fmt: str, wanted: dict[str, _Spec], channels: dict
                         f"the file has {_listing(listing)}")
     if len(problems) > n_before:
         return None
-    limit = max_samples()
+    limit = max_samples() * decimate  # a decimated record keeps 1 in `decimate` samples
     for column, ch in found.items():
         spec = wanted[column]
         vector = len([d for d in ch.shape if d != 1]) <= 1
@@ -316,7 +317,7 @@ def _read_channels(name: str, fmt: str, wanted: dict[str, _Spec], channels: dict
     largest = max(found.values(), key=lambda ch: ch.size)
     if len(problems) == n_before and largest.size > limit:  # one problem for the record
         problems.append(f"{name}: channel `{largest.name}`: {largest.size} samples; "
-                        f"{decimation_hint(largest.size)}")
+                        f"{decimation_hint(largest.size, decimate)}")
     if len(problems) > n_before:
         return None
     sizes = {column: ch.size for column, ch in found.items()}

@@ -127,19 +127,26 @@ def load_case(path: str | os.PathLike[str], *, strict: bool = False) -> Case:
         else:
             csv_problems: list[str] = []
             uniform = not (isinstance(t_table, Mapping) and "resample_hz" in t_table)
+            # a decimated record is read with as many more samples as it keeps fewer
+            factor = test.decimate if test is not None and test.decimate else 1
             if lab and motion is not None:
                 csv_problems.append(f"{fname}: [rig.motion]: a six-axis record is read from a "
                                     f"CSV file (`time`, the motion columns, the channels); "
                                     f"found {what} (export it to CSV)")
             elif lab:
                 arrays = read_lab(data_path, fname, doc, excitation, rig_kind, rig, csv_problems,
-                                  uniform=uniform, unitless=unitless)
+                                  uniform=uniform, unitless=unitless, decimate=factor)
             else:
                 arrays = read_csv(data_path, excitation, csv_problems, rig_kind, uniform=uniform,
-                                  motion=motion)
+                                  motion=motion, decimate=factor)
             problems.extend(csv_problems)
             if arrays is not None and test is not None and test.resample_hz is not None:
-                arrays, note = _uniform(data_path.name, arrays, test.resample_hz, problems)
+                arrays, note = _uniform(data_path.name, arrays, test.resample_hz, problems,
+                                        factor)
+                notes.append(note)
+            if arrays is not None and factor > 1:
+                arrays, note = _decimated(data_path.name, arrays, factor, problems,
+                                          test.motion_band_hz if test is not None else None)
                 notes.append(note)
             if arrays is not None and rig is not None:
                 from .spin import spin_column_problems
@@ -201,17 +208,19 @@ def _unit_warnings(name: str, unitless: dict[str, str], arrays: tuple, tank, liq
                          modes=modes, weighed=rig.dry_mass is not None, channels=unitless)
 
 
-def _uniform(name: str, arrays: tuple, rate_hz: float, problems: list[str]
+def _uniform(name: str, arrays: tuple, rate_hz: float, problems: list[str], factor: int
              ) -> tuple[tuple | None, str]:
     """``arrays`` (time, displacement, force, columns) on a uniform time base at about
-    ``rate_hz`` (:func:`estimate.data.timebase.uniform_record`), and what was done."""
+    ``rate_hz`` (:func:`estimate.data.timebase.uniform_record`), and what was done
+    (``factor``: the decimation that follows, which lets the grid hold as many more
+    samples)."""
     from .budget import max_samples
     from .timebase import uniform_record
 
     time, disp, force, columns = arrays
     named = {"displacement": disp, "force": force, **columns}
     record = uniform_record(name, time, {k: v for k, v in named.items() if v is not None},
-                            rate_hz, problems, max_samples=max_samples())
+                            rate_hz, problems, max_samples=max_samples() * factor)
     if record is None:
         return None, ""
     out = record.columns
@@ -219,3 +228,17 @@ def _uniform(name: str, arrays: tuple, rate_hz: float, problems: list[str]
              {k: out[k] for k in columns}), record.note)
 
 
+def _decimated(name: str, arrays: tuple, factor: int, problems: list[str],
+               motion_band_hz: float | None) -> tuple[tuple | None, str]:
+    """``arrays`` (time, displacement, force, columns) decimated by ``factor``
+    (:func:`estimate.data.decimation.decimate_record`), and what was done."""
+    from .decimation import decimate_record
+
+    time, disp, force, columns = arrays
+    named = {"displacement": disp, "force": force, **columns}
+    out = decimate_record(name, time, {k: v for k, v in named.items() if v is not None},
+                          factor, problems, motion_band_hz)
+    if out is None:
+        return None, ""
+    kept, ch, note = out
+    return (kept, ch.get("displacement"), ch.get("force"), {k: ch[k] for k in columns}), note

@@ -77,6 +77,9 @@ def _toml_text(test: TestInfo, tank: Tank, liquid: Liquid, rig: Rig,
         rows.append(("resample_hz", test.resample_hz, "Hz, a uniform time base for the record"))
     if test.motion_band_hz is not None:
         rows.append(("motion_band_hz", test.motion_band_hz, "Hz, top of the carriage motion"))
+    if test.decimate is not None:
+        rows.append(("decimate", test.decimate, "fit every k-th sample, after an anti-alias "
+                                                "low-pass"))
     table("test", rows)
     sizes = {"radius": "m", "length": "m, cylinder height or rectangular along the motion",
              "cylinder_length": "m, capsule straight section", "width": "m, across the motion",

@@ -102,13 +102,15 @@ class Uncertainty:
 def uncertainty(jac_residuals: sps.spmatrix, jac_constraints: sps.spmatrix,
                 residuals: np.ndarray, n_observations: int, ntheta: int, scales: np.ndarray,
                 names: tuple[str, ...], held: tuple[int, ...] = (),
-                samples: "list[np.ndarray] | None" = None) -> Uncertainty:
+                samples: "list[np.ndarray] | None" = None,
+                bands: "list[float] | None" = None) -> Uncertainty:
     """The Gauss-Newton covariance of the first ``ntheta`` decision variables (scaled by
     ``scales``) from the sparse residual and constraint Jacobians at the optimum; the
     parameters ``held`` (indices, at an active bound) are held there (see
     :class:`Uncertainty`). ``samples``, per case, gives the sample index of each of its
     residuals (cases in the order of the residuals, each case's residuals contiguous): with
-    it, the robust covariance is computed too (:func:`robust_covariance`)."""
+    it, the robust covariance is computed too (:func:`robust_covariance`; ``bands`` as
+    :func:`~estimate.fitting.spectral_sandwich.spectral_middle`'s)."""
     Je = sps.csc_matrix(jac_residuals)
     Jg = sps.csc_matrix(jac_constraints)
     nw, ng = Je.shape[1], Jg.shape[0]
@@ -161,7 +163,7 @@ def uncertainty(jac_residuals: sps.spmatrix, jac_constraints: sps.spmatrix,
         Xs[np.ix_(free, free)] = X
         robust, lags = robust_covariance(Xs, kkt.effective_jacobian(), residuals, samples,
                                          n_observations / max(n_observations - k, 1),
-                                         step=lambda w: kkt.Je @ kkt.step(w))
+                                         step=lambda w: kkt.Je @ kkt.step(w), bands=bands)
         robust = robust * np.outer(scales, scales)
     return Uncertainty(cov, d, corr, sigma2, ident, tuple(warnings), bound_se, robust, lags,
                        reach)
@@ -169,7 +171,8 @@ def uncertainty(jac_residuals: sps.spmatrix, jac_constraints: sps.spmatrix,
 
 def robust_covariance(information_inverse: np.ndarray, effective_jacobian: np.ndarray,
                       residuals: np.ndarray, samples: list[np.ndarray], dof_factor: float = 1.0,
-                      step=None) -> tuple[np.ndarray, tuple[int, ...]]:
+                      step=None, bands: list[float] | None = None
+                      ) -> tuple[np.ndarray, tuple[int, ...]]:
     """The covariance of the (scaled) parameters robust to heteroscedastic and autocorrelated
     residuals, and the Newey-West bandwidth of each case.
 
@@ -200,7 +203,7 @@ def robust_covariance(information_inverse: np.ndarray, effective_jacobian: np.nd
     widen = np.sqrt(np.where(np.isfinite(ratio), np.maximum(ratio, 1.0), 1.0))
     cov = dof_factor * (X @ lag0_all @ X) * np.outer(widen, widen)
     if step is not None:
-        spectral = np.diag(X @ spectral_middle(J, e, samples, step) @ X)
+        spectral = np.diag(X @ spectral_middle(J, e, samples, step, bands) @ X)
         with np.errstate(invalid="ignore", divide="ignore"):
             r = spectral / np.diag(cov)
         more = np.sqrt(np.where(np.isfinite(r), np.maximum(r, 1.0), 1.0))

@@ -11,6 +11,7 @@ from dataclasses import dataclass, replace
 import numpy as np
 import scipy.sparse as sps
 
+from ..data.decimation import noise_band
 from ._progress import Recorder
 from .assembly import NlpOutputs
 from .covariance import uncertainty
@@ -111,7 +112,8 @@ def fit_result(problem: FitProblem, solve: Solve) -> FitResult:
     held = np.array([bool(side) and not x.band for side, x in zip(at_bound, problem.estimated)])
     unc = uncertainty(Je, Jg, e, n_force + n_disp, theta.size,
                       np.array([x.scale for x in problem.estimated]), problem.names,
-                      held=tuple(np.flatnonzero(held)), samples=samples)
+                      held=tuple(np.flatnonzero(held)), samples=samples,
+                      bands=[noise_band(x.case) for x in problem.experiments])
     edge = [i for i, side in enumerate(at_bound) if side and not held[i]]
     if edge:
         spread = np.full(theta.size, np.nan) if unc.bound_stderr is None else unc.bound_stderr.copy()

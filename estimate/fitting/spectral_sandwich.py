@@ -44,14 +44,20 @@ MIN_BINS = 16
 COLOUR_F = 7.0
 
 
-def spectral_middle(J: np.ndarray, e: np.ndarray, samples: list[np.ndarray], step) -> np.ndarray:
+def spectral_middle(J: np.ndarray, e: np.ndarray, samples: list[np.ndarray], step,
+                    bands: list[float] | None = None) -> np.ndarray:
     """``Omega`` (parameters x parameters, scaled) of the residuals' sensitivity ``J``
     (residuals x parameters, nuisance re-estimated) from the noise spectra of each case's
     channels. ``samples`` as for :func:`estimate.fitting.covariance.robust_covariance`
     (per case, each residual row's sample index; -1 for the displacement's rows, which form
     one channel in sample order); ``step(w)`` the change ``J_e dw`` of residuals ``w`` by
     the Gauss-Newton step ``dw`` of all variables from them
-    (:meth:`estimate.fitting.covariance.ReducedKKT.step`)."""
+    (:meth:`estimate.fitting.covariance.ReducedKKT.step`). ``bands``, per case, the
+    highest frequency (cycles per sample; default 0.5, Nyquist) at which its records hold
+    the noise as it came: a decimated record's anti-alias filter takes the noise away above
+    :data:`estimate.data.decimation.FLAT`, and a noise model fitted there would read that
+    fall as coloured noise rising towards the slosh band (a 6 s record decimated by 2 to 5:
+    the masses' intervals 2.4-6.8 times the Gauss-Newton ones)."""
     p = J.shape[1]
     rng = np.random.default_rng(0)
     live = np.any(J != 0, axis=1) | (e != 0)
@@ -61,13 +67,14 @@ def spectral_middle(J: np.ndarray, e: np.ndarray, samples: list[np.ndarray], ste
         probes.append(w + step(w))
     omega = np.zeros((p, p))
     start = 0
-    for idx in samples:
+    for i, idx in enumerate(samples):
         idx = np.asarray(idx, int)
         rows = np.arange(start, start + idx.size)
         start += idx.size
+        band = 0.5 if bands is None else float(bands[i])
         for ch_rows in _channels(idx):
             r = rows[ch_rows]
-            omega += _channel_middle(J[r], e[r], [q[r] for q in probes], live[r])
+            omega += _channel_middle(J[r], e[r], [q[r] for q in probes], live[r], band)
     return 0.5 * (omega + omega.T)
 
 
@@ -88,9 +95,10 @@ def _channels(idx: np.ndarray) -> list[np.ndarray]:
     return out
 
 
-def _channel_middle(J: np.ndarray, e: np.ndarray, probes: list[np.ndarray], live: np.ndarray
-                    ) -> np.ndarray:
-    """One channel's ``sum_k J_k^H S_k J_k / N`` (see the module)."""
+def _channel_middle(J: np.ndarray, e: np.ndarray, probes: list[np.ndarray], live: np.ndarray,
+                    band: float = 0.5) -> np.ndarray:
+    """One channel's ``sum_k J_k^H S_k J_k / N`` (see the module), its noise read at most up
+    to ``band`` (cycles per sample)."""
     N, p = J.shape
     if N < 64 or not live.any():
         return np.zeros((p, p))
@@ -101,10 +109,10 @@ def _channel_middle(J: np.ndarray, e: np.ndarray, probes: list[np.ndarray], live
     g = P[1:].mean(axis=0) / float(np.mean(live))
     Jh = np.fft.fft(J, axis=0)
     fk = np.fft.fftfreq(N)
-    top = min(0.5, max(TOP_FACTOR * _energy_edge(Jh, fk), MIN_BINS / nper))
+    top = min(band, max(TOP_FACTOR * _energy_edge(Jh, fk), MIN_BINS / nper))
     use = (g >= G_MIN) & (f > 0) & (f <= top)
     if np.count_nonzero(use) < MIN_BINS:
-        use = (g >= G_MIN) & (f > 0)
+        use = (g >= G_MIN) & (f > 0) & (f <= band)
     if np.count_nonzero(use) < 4:
         return np.zeros((p, p))
     segments = max((N - nper) // (nper // 2) + 1, 1)

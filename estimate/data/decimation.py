@@ -1,0 +1,96 @@
+"""A record decimated for the fit: ``[test] decimate = k``.
+
+Rigs sample at 500 Hz to a few kHz; slosh modes lie below about 10 Hz and a carriage's motion
+a little above. The samples above a few tens of Hz hold only noise, and every one of them
+costs the fit time and memory (``estimate/data/budget.py``). ``[test] decimate = k`` keeps
+every ``k``-th sample after an anti-alias low-pass: an order-8 Butterworth filter whose
+half-power frequency is 0.8 times the new Nyquist frequency (0.4 times the new rate), run
+forward and backward (:func:`scipy.signal.sosfiltfilt`), so no channel is shifted in time and
+all keep their relative timing. Its gain is 1 to within 1e-9 below a tenth of the new rate
+(the slosh band) and to within 5e-4 below a quarter. A Chebyshev filter (SciPy's
+:func:`scipy.signal.decimate`) was not taken: its passband ripple, 0.989 at low frequencies
+forward and backward, scales the motion and the force alike, which a linear model absorbs but
+a swing-dependent one does not (the 0.25 rad swings of a 60 s sweep fitted after it put the
+pendulum length 13 standard errors off). Inside the passband the noise is unchanged, so the
+estimates lose no information the model can use; their intervals are computed from the
+decimated residuals as from any record, the noise spectrum read below :data:`FLAT` of the new
+rate (:func:`noise_band`), where the filter has not taken the noise away.
+
+The new rate must keep the slosh band well inside the passband: at least
+:data:`MIN_RATE_HZ`, and the passband above ``[test] motion_band_hz`` when that is given.
+"""
+
+from __future__ import annotations
+
+import numpy as np
+
+__all__ = ["FLAT", "MIN_RATE_HZ", "MIN_SAMPLES", "ORDER", "PASSBAND", "decimate_record",
+           "noise_band"]
+
+#: Lowest rate a record may be decimated to [Hz] (a passband to 16 Hz).
+MIN_RATE_HZ = 40.0
+#: The anti-alias filter's half-power frequency as a fraction of the new rate (0.8 of the
+#: new Nyquist frequency).
+PASSBAND = 0.4
+#: The anti-alias Butterworth filter's order.
+ORDER = 8
+#: The band (a fraction of the new rate) where the forward and backward filter passes at least
+#: 95 % of the noise's power: its gain is ``1 / (1 + (tan(pi f / fs) / tan(pi fc / fs))^16)``
+#: (``fs`` the record's rate, ``fc`` the half-power frequency), 0.98 or more there.
+FLAT = 0.3
+#: Fewest samples a decimated record keeps.
+MIN_SAMPLES = 100
+
+
+def decimate_record(name: str, time: np.ndarray, columns: dict[str, np.ndarray], factor: int,
+                    problems: list[str], motion_band_hz: float | None = None
+                    ) -> tuple[np.ndarray, dict[str, np.ndarray], str] | None:
+    """``time`` and every channel of ``columns`` decimated by ``factor`` (``name``: the data
+    file, for the messages), and a note of what was done; ``None`` (with the reasons in
+    ``problems``) when the record cannot be decimated soundly. ``time`` is uniform [s]."""
+    from scipy.signal import butter, sosfiltfilt
+
+    from .budget import _ordinal
+
+    where = f"{name}: [test] decimate = {factor}"
+    if factor == 1:
+        return time, columns, ""
+    rate = 1.0 / float(np.median(np.diff(time)))
+    new_rate = rate / factor
+    found = len(problems)
+    if new_rate < MIN_RATE_HZ:
+        problems.append(f"{where}: the record's {rate:.6g} Hz would become {new_rate:.3g} Hz; "
+                        f"expected at least {MIN_RATE_HZ:g} Hz (a passband to "
+                        f"{PASSBAND * MIN_RATE_HZ:g} Hz, above the slosh modes and the "
+                        f"carriage's motion): decimate by at most "
+                        f"{max(int(rate // MIN_RATE_HZ), 1)}")
+    elif motion_band_hz is not None and motion_band_hz > PASSBAND * new_rate:
+        problems.append(f"{where}: the passband would end at {PASSBAND * new_rate:.3g} Hz, "
+                        f"below [test] motion_band_hz = {motion_band_hz:g} Hz; decimate by at "
+                        f"most {max(int(PASSBAND * rate // motion_band_hz), 1)}")
+    if time.size // factor < MIN_SAMPLES:
+        problems.append(f"{where}: {time.size} samples would become {time.size // factor}; "
+                        f"expected at least {MIN_SAMPLES}")
+    bad = [k for k, v in columns.items() if not np.all(np.isfinite(v))]
+    if bad:
+        problems.append(f"{where}: channel{'s' if len(bad) > 1 else ''} "
+                        f"{', '.join(f'`{k}`' for k in bad)} hold non-finite values; the "
+                        "anti-alias filter needs every sample")
+    if len(problems) > found:
+        return None
+    sos = butter(ORDER, 2 * PASSBAND / factor, output="sos")  # of the record's Nyquist
+    out = {k: np.ascontiguousarray(sosfiltfilt(sos, np.asarray(v, float))[::factor])
+           for k, v in columns.items()}
+    kept = time[::factor].copy()
+    note = (f"{name}: decimated by {factor} for the fit ([test] decimate): {rate:.6g} -> "
+            f"{new_rate:.6g} Hz, {time.size} -> {kept.size} samples; every channel low-passed "
+            f"below {PASSBAND * new_rate:.3g} Hz forward and backward (no shift between "
+            f"channels), then every {factor}{_ordinal(factor)} sample kept")
+    return kept, out, note
+
+
+def noise_band(case) -> float:
+    """The highest frequency (cycles per sample) at which ``case``'s record holds its noise
+    as it was measured: 0.5 (Nyquist), or :data:`FLAT` when the record was decimated."""
+    factor = getattr(case.test, "decimate", None)
+    return FLAT if factor and factor > 1 else 0.5

@@ -1,0 +1,120 @@
+"""``[test] decimate = k``: a record sampled far above the slosh band fitted on every k-th
+sample after a zero-phase anti-alias low-pass (issue 27)."""
+
+from __future__ import annotations
+
+import math
+from pathlib import Path
+
+import numpy as np
+import pytest
+
+from estimate.data import CaseError, load_case
+from estimate.data.decimation import FLAT, ORDER, PASSBAND, decimate_record
+
+EXAMPLES = Path(__file__).resolve().parents[3] / "examples"
+
+
+def _amplitude(t: np.ndarray, y: np.ndarray, hz: float) -> tuple[float, float]:
+    """Amplitude and phase [rad] of the ``hz`` sinusoid in ``y`` (least squares with an
+    offset)."""
+    w = 2 * math.pi * hz
+    A = np.column_stack([np.cos(w * t), np.sin(w * t), np.ones_like(t)])
+    c, *_ = np.linalg.lstsq(A, y, rcond=None)
+    return float(np.hypot(c[0], c[1])), float(np.arctan2(-c[1], c[0]))
+
+
+def test_the_slosh_band_is_kept_exactly_and_the_rest_is_filtered_as_documented():
+    """A 2.1 Hz swing, a 45 Hz line and 150 Hz noise at 500 Hz, decimated by 5 (100 Hz): away
+    from the ends the swing keeps its amplitude and phase to 1e-6 (the forward-backward
+    Butterworth's gain ``1 / (1 + (tan(pi f / fs) / tan(pi fc / fs))^16)``, the bilinear
+    transform's, is 1 - 1e-19 there, and it shifts nothing); the 45 Hz line (above the flat
+    band, 0.3 of the new rate) keeps that gain, 0.122 (to 1 %), and the 150 Hz component, which
+    would alias to 50 Hz, is gone (gain 1e-12)."""
+    t = np.arange(10001) / 500.0
+    swing = 0.3 * np.cos(2 * math.pi * 2.1 * t + 0.7)
+    line = 0.01 * np.cos(2 * math.pi * 45.0 * t)
+    high = 0.2 * np.cos(2 * math.pi * 150.0 * t + 0.3)
+    problems: list[str] = []
+    kept, out, note = decimate_record("r.csv", t, {"force": swing + line + high,
+                                                   "displacement": swing}, 5, problems)
+    assert problems == [] and kept.size == 2001 and np.allclose(np.diff(kept), 0.01)
+    assert "500 -> 100 Hz, 10001 -> 2001 samples" in note and "every 5th sample" in note
+    inner = slice(100, -100)  # 1 s from the ends, past the filter's start-up
+    tk = kept[inner]
+    exact = 0.3 * np.cos(2 * math.pi * 2.1 * tk + 0.7)
+    assert np.max(np.abs(out["displacement"][inner] - exact)) < 1e-6 * 0.3
+    rest = out["force"][inner] - out["displacement"][inner]  # the line and what is left above
+    def gain(f, new_rate=100.0, factor=5):
+        fs, fc = new_rate * factor, PASSBAND * new_rate
+        return 1.0 / (1.0 + (math.tan(math.pi * f / fs) / math.tan(math.pi * fc / fs)) ** (2 * ORDER))
+
+    amp, _ = _amplitude(tk, rest, 45.0)
+    assert amp == pytest.approx(0.01 * gain(45.0), rel=0.01)
+    assert np.std(rest - amp * np.cos(2 * math.pi * 45.0 * tk + _amplitude(tk, rest, 45.0)[1])) \
+        < 1e-6 * 0.2
+    # the flat band: at least 95 % of the power passes up to FLAT of the new rate, whatever
+    # the factor (the bilinear transform only steepens the fall)
+    for factor in (2, 5, 10, 100):
+        assert gain(FLAT * 100.0, factor=factor) ** 2 >= 0.95
+
+
+def _case(folder: Path, test_lines: str, csv: bytes | None = None) -> Path:
+    if csv is not None:
+        (folder / "A1.csv").write_bytes(csv)
+    else:
+        (folder / "A1.csv").write_bytes((EXAMPLES / "A1.csv").read_bytes())
+    toml = (EXAMPLES / "A1.toml").read_text().replace("[test]\n", f"[test]\n{test_lines}\n", 1)
+    (folder / "A1.toml").write_text(toml)
+    return folder / "A1.toml"
+
+
+def test_a_case_file_decimates_its_record_and_says_so(tmp_path):
+    full = load_case(EXAMPLES / "A1.toml")
+    case = load_case(_case(tmp_path, "decimate = 2"))
+    assert case.test.decimate == 2
+    assert case.time.size == math.ceil(full.time.size / 2)
+    assert np.allclose(case.time, full.time[::2])
+    problems: list[str] = []
+    _, out, _ = decimate_record("A1.csv", full.time, {"force": full.force,
+                                                      "displacement": full.displacement},
+                                2, problems)
+    assert np.array_equal(case.force, out["force"])
+    assert np.array_equal(case.displacement, out["displacement"])
+    assert any("A1.csv: decimated by 2 for the fit ([test] decimate): 100 -> 50 Hz" in n
+               for n in case.notes)
+
+
+@pytest.mark.parametrize("value, expected", [
+    ("0", "[test] decimate: expected an integer >= 1 (keep every k-th sample after an "
+          "anti-alias low-pass), found an integer `0`"),
+    ("2.5", "found a float `2.5`"),
+    ('"5"', "found a string `'5'`"),
+    ("true", "found a boolean `True`"),
+    ("3", "A1.csv: [test] decimate = 3: the record's 100 Hz would become 33.3 Hz; expected at "
+          "least 40 Hz (a passband to 16 Hz, above the slosh modes and the carriage's motion): "
+          "decimate by at most 2"),
+    ("2\nmotion_band_hz = 25.0", "A1.csv: [test] decimate = 2: the passband would end at 20 Hz, "
+                                 "below [test] motion_band_hz = 25 Hz; decimate by at most 1"),
+])
+def test_a_decimation_the_record_cannot_take_is_refused(tmp_path, value, expected):
+    with pytest.raises(CaseError) as info:
+        load_case(_case(tmp_path, f"decimate = {value}"))
+    assert expected in str(info.value)
+
+
+def test_too_few_samples_left_are_refused(tmp_path):
+    rows = (EXAMPLES / "A1.csv").read_bytes().splitlines(keepends=True)[:151]  # 1.5 s
+    with pytest.raises(CaseError, match=r"150 samples would become 75; expected at least 100"):
+        load_case(_case(tmp_path, "decimate = 2", b"".join(rows)))
+
+
+def test_a_record_over_the_budget_is_read_when_it_is_decimated(tmp_path, monkeypatch):
+    """32 MiB admit 2048 samples: A1's 3001 are refused, with the case key that decimates
+    them; decimated by 2 (1501 samples) they are read."""
+    monkeypatch.setenv("SLOSH_MEMORY_BUDGET", "32M")
+    with pytest.raises(CaseError) as info:
+        load_case(_case(tmp_path, ""))
+    assert "3001 samples" in str(info.value) and "`[test] decimate = 2`" in str(info.value)
+    case = load_case(_case(tmp_path, "decimate = 2"))
+    assert case.time.size == 1501
