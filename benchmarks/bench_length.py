@@ -9,10 +9,15 @@ displacement noise 2e-5 m, force noise 1.3 % of its RMS; 3,001 / 10,001 / 30,001
 longest takes minutes) and fitted in a NEW process (`slosh fit`'s default model, estimated
 input), so that its peak memory is its own.
 
-Printed per row: samples, wall and CPU time of build + fit, IPOPT iterations, peak resident
-memory and its growth per sample over the process after imports (KiB), the time per sample
-as a ratio to the 3,001-sample row, and every estimate's error against the truth in its
-standard errors (z). The SciPy peer on the 3,001-sample records is ``bench_fit.py``'s.
+Each record is fitted twice: at its full rate, and decimated to 100 Hz by ``[test] decimate``
+(500 Hz by 5, 1 kHz by 10: a zero-phase anti-alias low-pass, then every k-th sample;
+``estimate/data/decimation.py``). ``--rate full|decimated|both`` picks them (default both).
+
+Printed per row: the record's samples (and those fitted), wall and CPU time of build + fit,
+IPOPT iterations, peak resident memory and its growth per recorded sample over the process
+after loading the case (KiB), the CPU time per recorded sample as a ratio to the 3,001-sample
+row's at the full rate, and every estimate's error against the truth in its standard errors
+(z). The SciPy peer on the 3,001-sample records is ``bench_fit.py``'s.
 """
 
 import argparse
@@ -57,7 +62,7 @@ t, c = time.perf_counter(), time.process_time()
 res = fit(FitProblem.build(case, model_from_spec("fixed,p1", case)), progress=False)
 wall, cpu = time.perf_counter() - t, time.process_time() - c
 peak = resource.getrusage(resource.RUSAGE_SELF).ru_maxrss
-print(json.dumps({{"n": int(case.time.size), "wall": wall, "cpu": cpu, "it": res.iterations,
+print(json.dumps({{"fitted": int(case.time.size), "wall": wall, "cpu": cpu, "it": res.iterations,
                   "status": res.status, "peak_kib": peak, "base_kib": base,
                   "values": dict(zip(res.names, map(float, res.values))),
                   "stderr": dict(zip(res.names, map(float, res.stderr)))}}))
@@ -77,17 +82,31 @@ def record(duration: float, rate: float, env: dict) -> Path:
     return path
 
 
+def decimated(path: Path, rate: float) -> Path:
+    """A case file beside ``path`` that fits its record decimated to 100 Hz."""
+    factor = int(round(rate / 100.0))
+    out = path.with_name(f"{path.stem}_d{factor}.toml")
+    text = path.read_text()
+    assert "[test]\n" in text and "decimate" not in text
+    out.write_text(text.replace("[test]\n", f"[test]\ndecimate = {factor}\n", 1))
+    return out
+
+
 def main() -> None:
     from estimate.data.budget import BUDGET_VARIABLE, DEFAULT_BUDGET, FIT_BYTES_PER_SAMPLE
 
     ap = argparse.ArgumentParser(description=__doc__.splitlines()[0])
     ap.add_argument("--max-samples", type=int, default=700_000,
                     help="skip the rows longer than this many samples")
+    ap.add_argument("--rate", choices=("full", "decimated", "both"), default="both",
+                    help="fit the records at their full rate, decimated to 100 Hz, or both")
     args = ap.parse_args()
     rows = []
-    print("| samples | wall s | CPU s | iterations | peak MB | KiB/sample | CPU/sample vs 3k | "
-          "z: fixed, p1 mass, p1 length |")
-    print("|---|---|---|---|---|---|---|---|")
+    print("| samples (fitted) | rate | wall s | CPU s | iterations | peak MB | KiB/sample | "
+          "CPU/sample vs 3k | z: fixed, p1 mass, p1 length |")
+    print("|---|---|---|---|---|---|---|---|---|")
+    modes = ("full", "decimated") if args.rate == "both" else (args.rate,)
+    base_per = None
     for duration, rate in ROWS:
         if duration * rate + 1 > args.max_samples:
             continue
@@ -98,16 +117,23 @@ def main() -> None:
         env.setdefault(BUDGET_VARIABLE, str(max(DEFAULT_BUDGET,
                                                 int(duration * rate + 1) * FIT_BYTES_PER_SAMPLE)))
         path = record(duration, rate, env)
-        out = subprocess.run([sys.executable, "-c", _FIT.format(root=str(ROOT), path=str(path))],
-                             check=True, capture_output=True, text=True, env=env).stdout
-        r = json.loads(out.strip().splitlines()[-1])
-        rows.append(r)
-        per = r["cpu"] / r["n"]
-        ratio = per / (rows[0]["cpu"] / rows[0]["n"])
-        z = ", ".join(f"{(r['values'][k] - v) / r['stderr'][k]:+.1f}" for k, v in TRUTH.items())
-        print(f"| {r['n']:,} | {r['wall']:.2f} | {r['cpu']:.2f} | {r['it']} | "
-              f"{r['peak_kib'] / 1024:.0f} | {(r['peak_kib'] - r['base_kib']) / r['n']:.1f} | "
-              f"{ratio:.2f} | {z} |", flush=True)
+        for mode in modes:
+            case = path if mode == "full" else decimated(path, rate)
+            out = subprocess.run([sys.executable, "-c",
+                                  _FIT.format(root=str(ROOT), path=str(case))],
+                                 check=True, capture_output=True, text=True, env=env).stdout
+            r = json.loads(out.strip().splitlines()[-1])
+            r["n"] = int(round(duration * rate)) + 1  # the record's samples
+            rows.append(r)
+            per = r["cpu"] / r["n"]
+            base_per = per if base_per is None else base_per  # the first row's
+            z = ", ".join(f"{(r['values'][k] - v) / r['stderr'][k]:+.1f}"
+                          for k, v in TRUTH.items())
+            fitted = f" ({r['fitted']:,})" if r["fitted"] != r["n"] else ""
+            print(f"| {r['n']:,}{fitted} | {rate * r['fitted'] / r['n']:.0f} Hz | "
+                  f"{r['wall']:.2f} | {r['cpu']:.2f} | {r['it']} | {r['peak_kib'] / 1024:.0f} | "
+                  f"{(r['peak_kib'] - r['base_kib']) / r['n']:.1f} | {per / base_per:.2f} | "
+                  f"{z} |", flush=True)
 
 
 if __name__ == "__main__":

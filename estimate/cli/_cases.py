@@ -28,8 +28,8 @@ def add_force(parser) -> None:
 
 
 def load_cases(paths: Sequence[str], *, prediction: bool = False, strict: bool = False,
-               motion_band_hz: float | None = None, shared: bool = False
-               ) -> tuple[list["Case"], list[str]]:
+               motion_band_hz: float | None = None, shared: bool = False,
+               decimate: int | None = None) -> tuple[list["Case"], list[str]]:
     """The cases of ``paths`` and warnings about them (``strict``: unknown keys are errors,
     :func:`estimate.data.load_case`).
 
@@ -38,7 +38,9 @@ def load_cases(paths: Sequence[str], *, prediction: bool = False, strict: bool =
     a warning (:func:`estimate.fitting.initial.prediction_conflicts`); ``motion_band_hz``
     (``--motion-band``, Hz) replaces every case's ``[test] motion_band_hz``; ``shared``:
     the cases are fitted with shared parameters, so records of different tanks, fills or
-    liquids are refused (:func:`estimate.data.records.refuse_mixed`).
+    liquids are refused (:func:`estimate.data.records.refuse_mixed`); ``decimate``
+    (``--decimate``) decimates every case's record as ``[test] decimate`` would
+    (:func:`estimate.data.decimation.decimate_case`).
     """
     from ..data import load_case
     from ..data.records import refuse_mixed, refuse_repeated
@@ -46,6 +48,10 @@ def load_cases(paths: Sequence[str], *, prediction: bool = False, strict: bool =
     cases = [load_case(p, strict=strict) for p in paths]
     if motion_band_hz is not None:
         cases = [replace(c, test=replace(c.test, motion_band_hz=motion_band_hz)) for c in cases]
+    if decimate is not None:
+        from ..data.decimation import decimate_case
+
+        cases = [decimate_case(c, decimate, "--decimate") for c in cases]
     refuse_repeated(cases)
     if shared:
         refuse_mixed(cases)
@@ -56,6 +62,28 @@ def load_cases(paths: Sequence[str], *, prediction: bool = False, strict: bool =
         for case in cases:
             notes += prediction_conflicts(case)
     return cases, notes
+
+
+def decimation_factor(text: str) -> int:
+    """An argparse type: an integer >= 1 (``--decimate``)."""
+    import argparse
+
+    try:
+        value = int(text)
+    except ValueError:
+        raise argparse.ArgumentTypeError(f"expected an integer >= 1, found {text!r}") from None
+    if value < 1:
+        raise argparse.ArgumentTypeError(f"expected an integer >= 1, found {text!r}")
+    return value
+
+
+def add_decimate(parser) -> None:
+    """The ``--decimate K`` option of the commands that fit."""
+    parser.add_argument("--decimate", type=decimation_factor, default=None, metavar="K",
+                        help="fit every K-th sample of each record after a zero-phase "
+                             "anti-alias low-pass, as the case key [test] decimate = K does "
+                             "(a record sampled far above the slosh band fits in a fraction "
+                             "of the time and memory; the new rate must be >= 40 Hz)")
 
 
 def positive_hz(text: str) -> float:

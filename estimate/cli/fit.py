@@ -5,7 +5,7 @@ from __future__ import annotations
 import argparse
 
 from ..outputs import Outputs
-from ._cases import add_strict, load_cases
+from ._cases import add_decimate, add_strict, load_cases
 from ._cases import positive_hz as _positive_hz
 
 __all__ = ["add_parser"]
@@ -53,6 +53,7 @@ def add_parser(sub: argparse._SubParsersAction) -> None:
                         "carriage spline's knot spacing and the filtered input's displacement "
                         "cutoff; default: the case's [test] motion_band_hz, else read from the "
                         "displacement (a carriage at rest needs none)")
+    add_decimate(p)
     p.add_argument("--overwrite", action="store_true", help="replace existing output files")
     add_strict(p)
     p.set_defaults(run=run)
@@ -88,7 +89,8 @@ def run(args: argparse.Namespace) -> int:
     outputs.file("--json", args.json_out).file("--plot", args.plot)
     outputs.file("--report", report_file).check()
     cases, notes = load_cases(args.cases, prediction=True, strict=args.strict,
-                              motion_band_hz=args.motion_band, shared=True)
+                              motion_band_hz=args.motion_band, shared=True,
+                              decimate=args.decimate)
     for w in notes:  # before the fit, which starts from [prediction]
         print(f"warning: {w}", file=sys.stderr)
     spec = BASELINE if args.model is None else args.model

@@ -24,8 +24,8 @@ from __future__ import annotations
 
 import numpy as np
 
-__all__ = ["FLAT", "MIN_RATE_HZ", "MIN_SAMPLES", "ORDER", "PASSBAND", "decimate_record",
-           "noise_band"]
+__all__ = ["FLAT", "MIN_RATE_HZ", "MIN_SAMPLES", "ORDER", "PASSBAND", "decimate_case",
+           "decimate_record", "noise_band"]
 
 #: Lowest rate a record may be decimated to [Hz] (a passband to 16 Hz).
 MIN_RATE_HZ = 40.0
@@ -94,3 +94,33 @@ def noise_band(case) -> float:
     as it was measured: 0.5 (Nyquist), or :data:`FLAT` when the record was decimated."""
     factor = getattr(case.test, "decimate", None)
     return FLAT if factor and factor > 1 else 0.5
+
+
+def decimate_case(case, factor: int, what: str = "decimate"):
+    """``case`` with its record decimated by ``factor`` (as ``[test] decimate = factor``
+    would have read it; ``what`` names the request in the messages, e.g. ``--decimate``).
+    Raises :class:`~estimate.data.case.CaseError` when the record cannot take it or is
+    decimated already."""
+    from dataclasses import replace
+
+    from .case import CaseError
+
+    if factor == 1:
+        return case
+    name = case.data_path.name
+    if case.test.decimate and case.test.decimate > 1:
+        raise CaseError([f"{case.path.name}: {what} {factor}: the case decimates its record "
+                         f"by {case.test.decimate} already ([test] decimate); give one of them"])
+    named = {"displacement": case.displacement, "force": case.force, **case.columns}
+    problems: list[str] = []
+    out = decimate_record(name, case.time, {k: v for k, v in named.items() if v is not None},
+                          factor, problems, case.test.motion_band_hz)
+    if out is None:
+        raise CaseError(problems)
+    kept, ch, note = out
+    for arr in (kept, *ch.values()):
+        arr.flags.writeable = False
+    return replace(case, time=kept, displacement=ch.get("displacement"), force=ch.get("force"),
+                   columns={k: ch[k] for k in case.columns},
+                   test=replace(case.test, decimate=factor),
+                   notes=(*case.notes, note.replace("([test] decimate)", f"({what})")))

@@ -118,3 +118,47 @@ def test_a_record_over_the_budget_is_read_when_it_is_decimated(tmp_path, monkeyp
     assert "3001 samples" in str(info.value) and "`[test] decimate = 2`" in str(info.value)
     case = load_case(_case(tmp_path, "decimate = 2"))
     assert case.time.size == 1501
+
+
+def test_slosh_fit_decimates_on_request_and_says_so(tmp_path, capsys):
+    """``--decimate 2`` fits A1's 3001 samples at 100 Hz as 1501 at 50 Hz, with the note in
+    the output and the JSON."""
+    import json
+
+    from estimate.cli import main
+
+    out = tmp_path / "fit.json"
+    assert main(["fit", str(EXAMPLES / "A1.toml"), "--decimate", "2", "--json", str(out)]) == 0
+    printed = capsys.readouterr().out
+    assert "note: A1.csv: decimated by 2 for the fit (--decimate): 100 -> 50 Hz, 3001 -> 1501" \
+        in printed
+    data = json.loads(out.read_text())
+    assert any("decimated by 2 for the fit (--decimate): 100 -> 50 Hz, 3001 -> 1501 samples" in n
+               for n in data["notes"])
+
+
+@pytest.mark.parametrize("value", ["0", "two"])
+def test_slosh_fit_refuses_a_decimation_that_is_not_a_factor(value, capsys):
+    from estimate.cli import main
+
+    with pytest.raises(SystemExit) as info:
+        main(["fit", str(EXAMPLES / "A1.toml"), "--decimate", value])
+    assert info.value.code == 2
+    assert f"--decimate: expected an integer >= 1, found '{value}'" in capsys.readouterr().err
+
+
+def test_slosh_fit_refuses_a_decimation_the_record_cannot_take(capsys):
+    from estimate.cli import main
+
+    assert main(["fit", str(EXAMPLES / "A1.toml"), "--decimate", "3"]) == 2
+    assert ("A1.csv: [test] decimate = 3: the record's 100 Hz would become 33.3 Hz"
+            in capsys.readouterr().err)
+
+
+def test_a_case_decimated_twice_is_refused(tmp_path, capsys):
+    from estimate.cli import main
+
+    assert main(["fit", str(_case(tmp_path, "decimate = 2")), "--decimate", "2"]) == 2
+    assert ("A1.toml: --decimate 2: the case decimates its record by 2 already ([test] "
+            "decimate); give one of them") in capsys.readouterr().err
+
