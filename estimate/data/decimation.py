@@ -24,8 +24,8 @@ from __future__ import annotations
 
 import numpy as np
 
-__all__ = ["FLAT", "MIN_RATE_HZ", "MIN_SAMPLES", "ORDER", "PASSBAND", "decimate_case",
-           "decimate_record", "noise_band"]
+__all__ = ["FLAT", "MIN_RATE_HZ", "MIN_SAMPLES", "ORDER", "PASSBAND", "angle_columns",
+           "decimate_case", "decimate_record", "noise_band"]
 
 #: Lowest rate a record may be decimated to [Hz] (a passband to 16 Hz).
 MIN_RATE_HZ = 40.0
@@ -43,11 +43,15 @@ MIN_SAMPLES = 100
 
 
 def decimate_record(name: str, time: np.ndarray, columns: dict[str, np.ndarray], factor: int,
-                    problems: list[str], motion_band_hz: float | None = None
+                    problems: list[str], motion_band_hz: float | None = None,
+                    angles: frozenset[str] = frozenset()
                     ) -> tuple[np.ndarray, dict[str, np.ndarray], str] | None:
     """``time`` and every channel of ``columns`` decimated by ``factor`` (``name``: the data
     file, for the messages), and a note of what was done; ``None`` (with the reasons in
-    ``problems``) when the record cannot be decimated soundly. ``time`` is uniform [s]."""
+    ``problems``) when the record cannot be decimated soundly. ``time`` is uniform [s]. The
+    columns named in ``angles`` (a spinning table's measured angle and nutation phase, rad)
+    are unwrapped first: filtered across a wrap from pi to -pi they would be wrong for a
+    filter's length, and they come back continuous."""
     from scipy.signal import butter, sosfiltfilt
 
     from .budget import _ordinal
@@ -79,7 +83,8 @@ def decimate_record(name: str, time: np.ndarray, columns: dict[str, np.ndarray],
     if len(problems) > found:
         return None
     sos = butter(ORDER, 2 * PASSBAND / factor, output="sos")  # of the record's Nyquist
-    out = {k: np.ascontiguousarray(sosfiltfilt(sos, np.asarray(v, float))[::factor])
+    out = {k: np.ascontiguousarray(sosfiltfilt(sos, np.unwrap(np.asarray(v, float))
+                                               if k in angles else np.asarray(v, float))[::factor])
            for k, v in columns.items()}
     kept = time[::factor].copy()
     note = (f"{name}: decimated by {factor} for the fit ([test] decimate): {rate:.6g} -> "
@@ -87,6 +92,16 @@ def decimate_record(name: str, time: np.ndarray, columns: dict[str, np.ndarray],
             f"below {PASSBAND * new_rate:.3g} Hz forward and backward (no shift between "
             f"channels), then every {factor}{_ordinal(factor)} sample kept")
     return kept, out, note
+
+
+def angle_columns(rig) -> frozenset[str]:
+    """The columns of ``rig``'s measured spin motion that hold angles (rad, unwrapped before
+    the low-pass): ``[rig.spin] spin_angle`` and ``nutation_phase``."""
+    spin = getattr(rig, "spin", None)
+    if spin is None:
+        return frozenset()
+    return frozenset(col for key, col in spin.columns.items()
+                     if key in ("spin_angle", "nutation_phase"))
 
 
 def noise_band(case) -> float:
@@ -114,7 +129,7 @@ def decimate_case(case, factor: int, what: str = "decimate"):
     named = {"displacement": case.displacement, "force": case.force, **case.columns}
     problems: list[str] = []
     out = decimate_record(name, case.time, {k: v for k, v in named.items() if v is not None},
-                          factor, problems, case.test.motion_band_hz)
+                          factor, problems, case.test.motion_band_hz, angle_columns(case.rig))
     if out is None:
         raise CaseError(problems)
     kept, ch, note = out
