@@ -30,7 +30,7 @@ from __future__ import annotations
 import numpy as np
 
 __all__ = ["FLAT", "MIN_RATE_HZ", "MIN_SAMPLES", "ORDER", "PASSBAND", "angle_columns",
-           "decimate_case", "decimate_record", "noise_band"]
+           "decimate_arrays", "decimate_case", "decimate_record", "noise_band"]
 
 #: Lowest rate a record may be decimated to [Hz] (a passband to 16 Hz).
 MIN_RATE_HZ = 40.0
@@ -116,6 +116,21 @@ def noise_band(case) -> float:
     return FLAT if factor and factor > 1 else 0.5
 
 
+def decimate_arrays(name: str, arrays: tuple, factor: int, problems: list[str],
+                    motion_band_hz: float | None, rig) -> tuple[tuple, str] | None:
+    """:func:`decimate_record` of a record as the case reader holds it, ``(time,
+    displacement, force, columns)`` (``displacement`` and ``force`` may be ``None``;
+    ``rig``'s angle columns unwrapped), in the same form, and what was done."""
+    time, disp, force, columns = arrays
+    named = {"displacement": disp, "force": force, **columns}
+    out = decimate_record(name, time, {k: v for k, v in named.items() if v is not None},
+                          factor, problems, motion_band_hz, angle_columns(rig))
+    if out is None:
+        return None
+    kept, ch, note = out
+    return (kept, ch.get("displacement"), ch.get("force"), {k: ch[k] for k in columns}), note
+
+
 def decimate_case(case, factor: int, what: str = "decimate"):
     """``case`` with its record decimated by ``factor`` (as ``[test] decimate = factor``
     would have read it; ``what`` names the request in the messages, e.g. ``--decimate``).
@@ -127,20 +142,19 @@ def decimate_case(case, factor: int, what: str = "decimate"):
 
     if factor == 1:
         return case
-    name = case.data_path.name
     if case.test.decimate and case.test.decimate > 1:
         raise CaseError([f"{case.path.name}: {what} {factor}: the case decimates its record "
                          f"by {case.test.decimate} already ([test] decimate); give one of them"])
-    named = {"displacement": case.displacement, "force": case.force, **case.columns}
     problems: list[str] = []
-    out = decimate_record(name, case.time, {k: v for k, v in named.items() if v is not None},
-                          factor, problems, case.test.motion_band_hz, angle_columns(case.rig))
+    out = decimate_arrays(case.data_path.name, (case.time, case.displacement, case.force,
+                                                dict(case.columns)),
+                          factor, problems, case.test.motion_band_hz, case.rig)
     if out is None:
         raise CaseError(problems)
-    kept, ch, note = out
-    for arr in (kept, *ch.values()):
-        arr.flags.writeable = False
-    return replace(case, time=kept, displacement=ch.get("displacement"), force=ch.get("force"),
-                   columns={k: ch[k] for k in case.columns},
+    (kept, disp, force, columns), note = out
+    for arr in (kept, disp, force, *columns.values()):
+        if arr is not None:
+            arr.flags.writeable = False
+    return replace(case, time=kept, displacement=disp, force=force, columns=columns,
                    test=replace(case.test, decimate=factor),
                    notes=(*case.notes, note.replace("([test] decimate)", f"({what})")))

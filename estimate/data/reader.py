@@ -145,8 +145,11 @@ def load_case(path: str | os.PathLike[str], *, strict: bool = False) -> Case:
                                         factor)
                 notes.append(note)
             if arrays is not None and factor > 1:
-                arrays, note = _decimated(data_path.name, arrays, factor, problems,
-                                          test.motion_band_hz if test is not None else None, rig)
+                from .decimation import decimate_arrays
+
+                out = decimate_arrays(data_path.name, arrays, factor, problems,
+                                      test.motion_band_hz if test is not None else None, rig)
+                arrays, note = out if out is not None else (None, "")
                 notes.append(note)
             if arrays is not None and rig is not None:
                 from .spin import spin_column_problems
@@ -226,20 +229,3 @@ def _uniform(name: str, arrays: tuple, rate_hz: float, problems: list[str], fact
     out = record.columns
     return ((record.time, out.get("displacement"), out.get("force"),
              {k: out[k] for k in columns}), record.note)
-
-
-def _decimated(name: str, arrays: tuple, factor: int, problems: list[str],
-               motion_band_hz: float | None, rig) -> tuple[tuple | None, str]:
-    """``arrays`` (time, displacement, force, columns) decimated by ``factor``
-    (:func:`estimate.data.decimation.decimate_record`; ``rig``'s angle columns unwrapped),
-    and what was done."""
-    from .decimation import angle_columns, decimate_record
-
-    time, disp, force, columns = arrays
-    named = {"displacement": disp, "force": force, **columns}
-    out = decimate_record(name, time, {k: v for k, v in named.items() if v is not None},
-                          factor, problems, motion_band_hz, angle_columns(rig))
-    if out is None:
-        return None, ""
-    kept, ch, note = out
-    return (kept, ch.get("displacement"), ch.get("force"), {k: ch[k] for k in columns}), note
