@@ -35,7 +35,9 @@ __all__ = ["write_case"]
 def _toml_value(value: Any) -> str:
     if isinstance(value, bool):
         return "true" if value else "false"
-    if isinstance(value, (int, float)):
+    if isinstance(value, int):  # a count ([test] decimate) stays a TOML integer
+        return str(value)
+    if isinstance(value, float):
         number = float(value)
         if not math.isfinite(number):
             raise ValueError(f"cannot write a non-finite number {value!r} to a case file")

@@ -166,11 +166,12 @@ class DesignProblem:
         scales = np.where(np.isfinite(se), se, np.where(theta != 0, np.abs(theta), 1.0))
         targets = _targets(targets, names, fit, fit_path)
         channels = tuple(c for c in dm.measured if c in case.channels)
-        noise, rms, sx, notes = _noise(raw, fit_path, case, channels, model, values)
+        # the rig's rate: a decimated case ([test] decimate) was recorded k times faster
+        rate = limits.sample_rate or float(
+            f"{case.sample_rate * (case.test.decimate or 1):.9g}")
+        noise, rms, sx, notes = _noise(raw, fit_path, case, channels, model, values, rate)
         freqs = {k.split(".")[0]: float(v) for k, v in (raw.get("derived") or {}).items()
                  if k.endswith(".frequency_hz") and isinstance(v, (int, float))}
-        # the record's rate from its median step, to 9 digits (100.00000000000213 is 100 Hz)
-        rate = limits.sample_rate or float(f"{case.sample_rate:.9g}")
         return cls(case, model, dm, limits, names, values, prior, scales, targets, criterion,
                    channels, noise, rms, sx, float(duration), float(rate), float(max_swing),
                    freqs, float(goal), {n: fit.units.get(n, "") for n in names},
@@ -232,20 +233,30 @@ def _targets(targets, names, fit, fit_path) -> tuple[str, ...]:
     return tuple(out) or tuple(names)
 
 
-def _noise(raw, fit_path, case: Case, channels, model, values):
-    """White noise per channel of the fitted record, its RMS per channel (from ``case``'s
-    record) and the displacement noise, with notes saying where they come from."""
+def _noise(raw, fit_path, case: Case, channels, model, values, rate: float):
+    """White noise per channel of a sample at the rig's ``rate`` (Hz), the fitted record's
+    RMS per channel (from ``case``'s record) and the displacement noise, with notes saying
+    where they come from. A fit record gives its noise per sample of the fitted record and
+    (since it says so) that record's rate: a white noise's density is what carries over,
+    so a sample at another rate has the noise times ``sqrt(rate / fitted rate)`` (a record
+    fitted decimated by 5 has a fifth of the variance per sample)."""
     measured = np.array([case.channels[c] for c in channels], float)
     rms = np.sqrt(np.mean(measured**2, axis=1))
     entries = raw.get("noise") if isinstance(raw, dict) else None
     first = entries[0] if isinstance(entries, list) and entries else None
     if isinstance(first, dict) and isinstance(first.get("force_noise_N"), (int, float)):
         sx = first.get("displacement_noise_m")
-        return (np.array([float(first["force_noise_N"])]), rms,
-                float(sx) if isinstance(sx, (int, float)) else None,
-                [f"noise of the fitted record: force {first['force_noise_N']:.3g} N"
-                 + (f", displacement {sx:.3g} m" if isinstance(sx, (int, float)) else "")
-                 + f" ({fit_path})"])
+        sx = float(sx) if isinstance(sx, (int, float)) else None
+        fitted = first.get("sample_rate_hz")
+        scale = (math.sqrt(rate / fitted) if isinstance(fitted, (int, float)) and fitted > 0
+                 else 1.0)
+        note = (f"noise of the fitted record: force {first['force_noise_N']:.3g} N"
+                + (f", displacement {sx:.3g} m" if sx is not None else "") + f" ({fit_path})")
+        if abs(scale - 1.0) > 1e-6:
+            note += (f"; per sample at the rig's {rate:.6g} Hz from the fitted record's "
+                     f"{fitted:.6g} Hz: times {scale:.3g} (a white noise's density kept)")
+        return (np.array([float(first["force_noise_N"]) * scale]), rms,
+                None if sx is None else sx * scale, [note])
     # no noise figure in the fit (spinning rig, filtered input): the residual of the fit on
     # this case's record, channel by channel
     from ..data.experiment import experiment
@@ -253,7 +264,8 @@ def _noise(raw, fit_path, case: Case, channels, model, values):
     exp = experiment(case, model)
     sim = exp.simulate({k: v for k, v in values.items() if k in exp.derived.parameter_names})
     resid = measured - np.array([sim.output(c) for c in channels])
-    noise = np.sqrt(np.mean(resid**2, axis=1))
+    # per sample of this record; at the rig's rate as above (a decimated record)
+    noise = np.sqrt(np.mean(resid**2, axis=1)) * math.sqrt(rate / case.sample_rate)
     return noise, rms, None, [
         "noise per channel: the RMS residual of the fitted model on " + str(case.path.name)
         + " (" + ", ".join(f"{c} {s:.3g}" for c, s in zip(channels, noise)) + ")"]

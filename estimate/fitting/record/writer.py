@@ -45,11 +45,13 @@ def information_criteria(result: "FitResult") -> dict[str, Any]:
             "minus_two_log_likelihood": m2ll, "likelihood": form}
 
 
-def _noise_dict(carriage: Any, noise: Any) -> dict[str, Any] | None:
-    """Noise levels, tones and the carriage estimate's settings of one case."""
+def _noise_dict(carriage: Any, noise: Any, rate_hz: float) -> dict[str, Any] | None:
+    """Noise levels (per sample of the fitted record, sampled at ``rate_hz``), tones and the
+    carriage estimate's settings of one case."""
     if noise is None:
         return None
-    out: dict[str, Any] = {"force_noise_N": noise.force_noise, "band_hz": noise.band_hz,
+    out: dict[str, Any] = {"force_noise_N": noise.force_noise, "sample_rate_hz": rate_hz,
+                           "band_hz": noise.band_hz,
                            "force_tones": [{"hz": f, "amplitude_N": a} for f, a in noise.tones]}
     if carriage is not None:
         out |= {"displacement_noise_m": carriage.displacement_noise,
@@ -186,8 +188,9 @@ def fit_record(result: "FitResult", *, model_spec: str | None = None,
                           for figs in result.noise_figures],
         "residual_over_noise": [_number(result.residual_over_noise(i))
                                 for i in range(len(result.noise_figures))],
-        "noise": [_noise_dict(ci, rn) for ci, rn in zip(problem.carriage or [None] * n,
-                                                         problem.noise or [None] * n)],
+        "noise": [_noise_dict(ci, rn, float(e.case.sample_rate))
+                  for ci, rn, e in zip(problem.carriage or [None] * n, problem.noise or [None] * n,
+                                       experiments)],
         "provenance": provenance([e.case for e in experiments], options=options,
                                  model_spec=model_spec, command=command),
     }
