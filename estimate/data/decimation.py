@@ -56,19 +56,20 @@ MIN_SAMPLES = 100
 
 def decimate_record(name: str, time: np.ndarray, columns: dict[str, np.ndarray], factor: int,
                     problems: list[str], motion_band_hz: float | None = None,
-                    angles: frozenset[str] = frozenset()
+                    angles: frozenset[str] = frozenset(), what: str = "[test] decimate ="
                     ) -> tuple[np.ndarray, dict[str, np.ndarray], str] | None:
     """``time`` and every channel of ``columns`` decimated by ``factor`` (``name``: the data
     file, for the messages), and a note of what was done; ``None`` (with the reasons in
     ``problems``) when the record cannot be decimated soundly. ``time`` is uniform [s]. The
     columns named in ``angles`` (a spinning table's measured angle and nutation phase, rad)
     are unwrapped first: filtered across a wrap from pi to -pi they would be wrong for a
-    filter's length, and they come back continuous."""
+    filter's length, and they come back continuous. ``what`` names the request in the
+    messages (``--decimate`` from the command line)."""
     from scipy.signal import butter, sosfiltfilt
 
     from .budget import _ordinal
 
-    where = f"{name}: [test] decimate = {factor}"
+    where = f"{name}: {what} {factor}"
     if factor == 1:
         return time, columns, ""
     rate = 1.0 / float(np.median(np.diff(time)))
@@ -99,7 +100,7 @@ def decimate_record(name: str, time: np.ndarray, columns: dict[str, np.ndarray],
                                                if k in angles else np.asarray(v, float))[::factor])
            for k, v in columns.items()}
     kept = time[::factor].copy()
-    note = (f"{name}: decimated by {factor} for the fit ([test] decimate): {rate:.6g} -> "
+    note = (f"{name}: decimated by {factor} for the fit ({what.rstrip(' =')}): {rate:.6g} -> "
             f"{new_rate:.6g} Hz, {time.size} -> {kept.size} samples; every channel low-passed "
             f"below {PASSBAND * new_rate:.3g} Hz forward and backward (no shift between "
             f"channels), then every {factor}{_ordinal(factor)} sample kept")
@@ -124,14 +125,15 @@ def noise_band(case) -> float:
 
 
 def decimate_arrays(name: str, arrays: tuple, factor: int, problems: list[str],
-                    motion_band_hz: float | None, rig) -> tuple[tuple, str] | None:
+                    motion_band_hz: float | None, rig, what: str = "[test] decimate ="
+                    ) -> tuple[tuple, str] | None:
     """:func:`decimate_record` of a record as the case reader holds it, ``(time,
     displacement, force, columns)`` (``displacement`` and ``force`` may be ``None``;
     ``rig``'s angle columns unwrapped), in the same form, and what was done."""
     time, disp, force, columns = arrays
     named = {"displacement": disp, "force": force, **columns}
     out = decimate_record(name, time, {k: v for k, v in named.items() if v is not None},
-                          factor, problems, motion_band_hz, angle_columns(rig))
+                          factor, problems, motion_band_hz, angle_columns(rig), what)
     if out is None:
         return None
     kept, ch, note = out
@@ -155,7 +157,7 @@ def decimate_case(case, factor: int, what: str = "decimate"):
     problems: list[str] = []
     out = decimate_arrays(case.data_path.name, (case.time, case.displacement, case.force,
                                                 dict(case.columns)),
-                          factor, problems, case.test.motion_band_hz, case.rig)
+                          factor, problems, case.test.motion_band_hz, case.rig, what)
     if out is None:
         raise CaseError(problems)
     (kept, disp, force, columns), note = out
@@ -164,7 +166,7 @@ def decimate_case(case, factor: int, what: str = "decimate"):
             arr.flags.writeable = False
     return replace(case, time=kept, displacement=disp, force=force, columns=columns,
                    test=replace(case.test, decimate=factor),
-                   notes=(*case.notes, note.replace("([test] decimate)", f"({what})")))
+                   notes=(*case.notes, note))
 
 
 def decimation_hint(case) -> str | None:

@@ -151,7 +151,7 @@ def test_slosh_fit_refuses_a_decimation_the_record_cannot_take(capsys):
     from estimate.cli import main
 
     assert main(["fit", str(EXAMPLES / "A1.toml"), "--decimate", "3"]) == 2
-    assert ("A1.csv: [test] decimate = 3: the record's 100 Hz would become 33.3 Hz"
+    assert ("A1.csv: --decimate 3: the record's 100 Hz would become 33.3 Hz"
             in capsys.readouterr().err)
 
 
