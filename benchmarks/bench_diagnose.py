@@ -66,12 +66,8 @@ def _hardware60(folder: Path):
     _, sim = make_case(folder, "hardware60", drive, pendulums=[p], fixed_mass=2.842 - p.mass,
                        dry_mass=1.2, duration=60.0, rate=500.0, seed=7, noise=0.0,
                        sensor_delay=0.02)
-    csv, toml = folder / "hardware60.csv", folder / "hardware60.toml"
-    data = np.loadtxt(csv, delimiter=",", skiprows=1)
-    data[:, 2] = rr.force_sensor(sim["time"], sim["force"], rng=np.random.default_rng(7),
-                                 offset=0.0)
-    np.savetxt(csv, data, delimiter=",", header="time,displacement,force", comments="",
-               fmt="%.12g")
+    rr.force_through_sensor(folder / "hardware60.csv", sim, 7)
+    toml = folder / "hardware60.toml"
     toml.write_text(toml.read_text().replace("dry_mass = 1.2", 'dry_mass = "estimate"'))
     return load_case(toml)
 

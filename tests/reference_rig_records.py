@@ -31,7 +31,7 @@ import numpy as np
 from numpy.typing import ArrayLike, NDArray
 from scipy import signal
 
-__all__ = ["TransportMove", "ServoFollow", "force_sensor", "sensor_group_delay",
+__all__ = ["TransportMove", "ServoFollow", "force_sensor", "force_through_sensor", "sensor_group_delay",
            "encoder_position", "receive_times", "cylinder_first_mode", "sphere_liquid_mass"]
 
 Array = NDArray[np.float64]
@@ -157,6 +157,17 @@ def force_sensor(t: ArrayLike, force: ArrayLike, *, rng: np.random.Generator,
     _, filtered, _ = signal.lsim(sys, raw - raw[0], tt - tt[0], interp=True)
     filtered = filtered + raw[0]
     return quantum * np.round(filtered / quantum) if quantum else filtered
+
+
+def force_through_sensor(csv, sim: dict, seed: int) -> None:
+    """Replace the force column of a ``time,displacement,force`` CSV (``synthetic_cases.
+    make_case``'s) by what :func:`force_sensor` records of the simulated force ``sim`` (no
+    offset; its generator seeded with ``seed``)."""
+    data = np.loadtxt(csv, delimiter=",", skiprows=1)
+    data[:, 2] = force_sensor(sim["time"], sim["force"], rng=np.random.default_rng(seed),
+                              offset=0.0)
+    np.savetxt(csv, data, delimiter=",", header="time,displacement,force", comments="",
+               fmt="%.12g")
 
 
 def encoder_position(position: ArrayLike, *, rng: np.random.Generator, resolution: float = 5e-6,

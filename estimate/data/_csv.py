@@ -100,8 +100,7 @@ def read_csv(path: Path, excitation: str | None, problems: list[str],
         with io.TextIOWrapper(open_input(path, "a CSV file"), newline="",
                               encoding="utf-8-sig") as fh:
             return _read_rows(csv.reader(fh), n_lines, name, excitation, problems, rig_kind,
-                              ended=ended, uniform=uniform, motion=motion, limit=limit,
-                              decimate=decimate)
+                              ended=ended, uniform=uniform, motion=motion, decimate=decimate)
     except InputError as exc:  # replaced by a pipe or a device since it was checked
         problems.append(f"{name}: {str(exc).split(': ', 1)[-1]}")
         return None
@@ -121,8 +120,9 @@ def _rows(reader) -> Iterator[tuple[int, list[str]]]:
 
 def _read_rows(reader, n_lines: int, name: str, excitation: str | None, problems: list[str],
                rig_kind: str | None, *, ended: bool = True, uniform: bool = True,
-               motion: Mapping[str, str] | None = None, limit: int, decimate: int = 1
+               motion: Mapping[str, str] | None = None, decimate: int = 1
                ) -> tuple[Any, ...] | None:
+    limit = max_samples() * decimate
     rows = _rows(reader)
     first = next(rows, None)
     # a six-axis record reads like a spinning-rig one: named columns, all kept

@@ -386,6 +386,12 @@ class Case:
         return 1.0 / self.sample_interval
 
     @property
+    def recorded_rate(self) -> float:
+        """The rate the record was taken at [Hz]: :attr:`sample_rate` times ``[test]
+        decimate`` (the record is held decimated)."""
+        return self.sample_rate * (self.test.decimate or 1)
+
+    @property
     def n_samples(self) -> int:
         """Number of samples."""
         return int(self.time.size)

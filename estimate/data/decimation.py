@@ -29,9 +29,9 @@ from __future__ import annotations
 
 import numpy as np
 
-__all__ = ["FLAT", "HINT_RATE_HZ", "HINT_SAMPLES", "MIN_RATE_HZ", "MIN_SAMPLES", "ORDER",
+__all__ = ["FLAT", "MIN_RATE_HZ", "MIN_SAMPLES", "NOTE_RATE_HZ", "NOTE_SAMPLES", "ORDER",
            "PASSBAND", "angle_columns", "decimate_arrays", "decimate_case", "decimate_record",
-           "decimation_hint", "noise_band"]
+           "decimation_note", "noise_band"]
 
 #: Lowest rate a record may be decimated to [Hz] (a passband to 16 Hz).
 MIN_RATE_HZ = 40.0
@@ -44,12 +44,12 @@ ORDER = 8
 #: 95 % of the noise's power: its gain is ``1 / (1 + (tan(pi f / fs) / tan(pi fc / fs))^16)``
 #: (``fs`` the record's rate, ``fc`` the half-power frequency), 0.98 or more there.
 FLAT = 0.3
-#: A record of at least this many samples at twice :data:`HINT_RATE_HZ` or more is told that
-#: decimating would fit it faster (:func:`decimation_hint`): from a 20 s, 500 Hz record on,
+#: A record of at least this many samples at twice :data:`NOTE_RATE_HZ` or more is told that
+#: decimating would fit it faster (:func:`decimation_note`): from a 20 s, 500 Hz record on,
 #: the fit takes half the time or less decimated to 100 Hz.
-HINT_SAMPLES = 10_000
-#: The rate :func:`decimation_hint` proposes [Hz].
-HINT_RATE_HZ = 100.0
+NOTE_SAMPLES = 10_000
+#: The rate :func:`decimation_note` proposes [Hz].
+NOTE_RATE_HZ = 100.0
 #: Fewest samples a decimated record keeps.
 MIN_SAMPLES = 100
 
@@ -169,20 +169,20 @@ def decimate_case(case, factor: int, what: str = "decimate"):
                    notes=(*case.notes, note))
 
 
-def decimation_hint(case) -> str | None:
+def decimation_note(case) -> str | None:
     """A note for a long record sampled far above the slosh band that is fitted at its full
     rate (no ``[test] decimate``): by how much to decimate it to about
-    :data:`HINT_RATE_HZ`; ``None`` otherwise. A lateral rig only (the spinning rig's
+    :data:`NOTE_RATE_HZ`; ``None`` otherwise. A lateral rig only (the spinning rig's
     records are fitted as they come)."""
     if case.test.decimate is not None or case.test.rig != "lateral":
         return None
     n = case.time.size
     rate = case.sample_rate
-    factor = int(rate // HINT_RATE_HZ)
+    factor = int(rate // NOTE_RATE_HZ)
     band = case.test.motion_band_hz
     if band is not None:
         factor = min(factor, int(PASSBAND * rate // band))
-    if n < HINT_SAMPLES or factor < 2 or n // factor < MIN_SAMPLES:
+    if n < NOTE_SAMPLES or factor < 2 or n // factor < MIN_SAMPLES:
         return None
     return (f"{case.data_path.name}: {n} samples at {rate:.6g} Hz, far above the slosh band: "
             f"`[test] decimate = {factor}` (or --decimate {factor}) fits them at "

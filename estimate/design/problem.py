@@ -166,9 +166,9 @@ class DesignProblem:
         scales = np.where(np.isfinite(se), se, np.where(theta != 0, np.abs(theta), 1.0))
         targets = _targets(targets, names, fit, fit_path)
         channels = tuple(c for c in dm.measured if c in case.channels)
-        # the rig's rate: a decimated case ([test] decimate) was recorded k times faster
-        rate = limits.sample_rate or float(
-            f"{case.sample_rate * (case.test.decimate or 1):.9g}")
+        # the rig's rate from the record's median step, to 9 digits (100.00000000000213 is
+        # 100 Hz), before any [test] decimate
+        rate = limits.sample_rate or float(f"{case.recorded_rate:.9g}")
         noise, rms, sx, notes = _noise(raw, fit_path, case, channels, model, values, rate)
         freqs = {k.split(".")[0]: float(v) for k, v in (raw.get("derived") or {}).items()
                  if k.endswith(".frequency_hz") and isinstance(v, (int, float))}

@@ -15,7 +15,7 @@ from analogs import Model
 from analogs.errors import InputError, UnknownNameError
 
 from ..data.case import Case
-from ..data.decimation import decimation_hint
+from ..data.decimation import decimation_note
 from ..data.experiment import Experiment, experiment
 from ..data.models import model_for_case
 from ..data.records import refuse_repeated
@@ -328,7 +328,7 @@ def build_problem(cls, cases: Case | Sequence[Case], model: Model, *,
     params = model_parameters(exps, measurement)
     raise_all(name_problems(args, estimate, params, exps, measurement))
     notes = [n for c in cases for n in c.notes]  # what loading did to the records
-    notes += [n for c in cases if (n := decimation_hint(c))]
+    notes += [n for c in cases if (n := decimation_note(c))]
     six_axis = any(c.motion is not None for c in cases)
     if six_axis:
         from ..data.motion import input_note

@@ -3,6 +3,7 @@
 import numpy as np
 import pytest
 import reference_models as ref
+import reference_rig_records as rr
 from synthetic_cases import make_case, pendulum, rig_record
 
 from estimate import FitProblem, fit, model_from_spec
@@ -149,19 +150,6 @@ def test_intervals_cover_a_weak_spring_the_fit_may_hold_at_zero(tmp_path):
     assert all(h >= 34 for h in hits.values()), hits
 
 
-def _through_transducer(csv, sim, seed: int) -> None:
-    """Replace the force column of ``csv`` by what the six-axis transducer's model records
-    of the simulated force (``reference_rig_records.force_sensor``, no offset)."""
-    import reference_rig_records as rr
-
-    force = rr.force_sensor(sim["time"], sim["force"], rng=np.random.default_rng(seed),
-                            offset=0.0)
-    data = np.loadtxt(csv, delimiter=",", skiprows=1)
-    data[:, 2] = force
-    np.savetxt(csv, data, delimiter=",", header="time,displacement,force", comments="",
-               fmt="%.12g")
-
-
 @pytest.mark.slow
 @pytest.mark.parametrize("decimate", [1, 5])
 def test_intervals_cover_the_masses_of_long_sine_records_through_a_transducer(tmp_path,
@@ -188,7 +176,7 @@ def test_intervals_cover_the_masses_of_long_sine_records_through_a_transducer(tm
         drive = ref.Ramped(ref.Sine(0.002, 0.9 * f1), 1.0, 0.0)
         case, sim = make_case(tmp_path, f"L{seed}", drive, pendulums=[p], duration=60.0,
                               rate=500.0, seed=seed, noise=0.0, sensor_delay=0.015)
-        _through_transducer(tmp_path / f"L{seed}.csv", sim, seed)
+        rr.force_through_sensor(tmp_path / f"L{seed}.csv", sim, seed)
         toml = tmp_path / f"L{seed}.toml"
         toml.write_text(toml.read_text().replace("[test]\n", f"[test]\ndecimate = {decimate}\n"))
         res = fit(FitProblem.build(load_case(toml), model_from_spec("fixed,p1", case)),
@@ -249,7 +237,7 @@ def test_intervals_cover_an_unweighed_container_through_a_transducer_with_large_
         case, sim = make_case(tmp_path, f"U{seed}", drive, pendulums=[p],
                               fixed_mass=liquid - p.mass, dry_mass=1.2, duration=20.0,
                               rate=500.0, seed=seed, noise=0.0, sensor_delay=0.02)
-        _through_transducer(tmp_path / f"U{seed}.csv", sim, seed)
+        rr.force_through_sensor(tmp_path / f"U{seed}.csv", sim, seed)
         toml = tmp_path / f"U{seed}.toml"
         text = toml.read_text()
         assert "dry_mass = 1.2" in text
