@@ -234,21 +234,21 @@ RECORDS: dict[str, Record] = {
 }
 
 
-def build(name: str, folder) -> tuple:
-    """Write record ``name`` of :data:`RECORDS` into ``folder``; returns ``(case,
-    simulation dict)``."""
-    return write(RECORDS[name], folder, name)
+def build(name: str, folder, rate: float = 100.0) -> tuple:
+    """Write record ``name`` of :data:`RECORDS` into ``folder`` sampled at ``rate`` (Hz);
+    returns ``(case, simulation dict)``."""
+    return write(RECORDS[name], folder, name, rate)
 
 
-def write(rec: Record, folder, name: str) -> tuple:
-    """Write the record ``rec`` as ``name`` into ``folder``; returns ``(case, simulation
-    dict)``."""
+def write(rec: Record, folder, name: str, rate: float = 100.0) -> tuple:
+    """Write the record ``rec`` as ``name`` into ``folder`` sampled at ``rate`` (Hz; the
+    noise levels are per sample at any rate); returns ``(case, simulation dict)``."""
     s = rec.scale
     return make_case(folder, name, rec.drive, pendulums=list(rec.pendulums),
                      fixed_mass=rec.fixed_mass, dry_mass=1.2 * s**3, noise=0.013,
                      displacement_noise=rec.displacement_noise * s, seed=rec.seed,
                      prediction=rec.prediction, fill=rec.fill, diaphragm=rec.diaphragm,
-                     radius=0.1016 * s, duration=rec.duration, **rec.effects)
+                     radius=0.1016 * s, duration=rec.duration, rate=rate, **rec.effects)
 
 
 # -- short records of the per-family tests (tests/estimate/diagnosis/families/) ---------------

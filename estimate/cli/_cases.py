@@ -83,7 +83,10 @@ def add_decimate(parser) -> None:
                         help="fit every K-th sample of each record after a zero-phase "
                              "anti-alias low-pass, as the case key [test] decimate = K does "
                              "(a record sampled far above the slosh band fits in a fraction "
-                             "of the time and memory; the new rate must be >= 40 Hz)")
+                             "of the time and memory; the new rate must be >= 40 Hz); "
+                             "1: every sample, also in the diagnosis's search, which "
+                             "otherwise screens a long record sampled far above the slosh "
+                             "band decimated to about 100 Hz")
 
 
 def positive_hz(text: str) -> float:

@@ -31,7 +31,7 @@ import numpy as np
 
 __all__ = ["FLAT", "MIN_RATE_HZ", "MIN_SAMPLES", "NOTE_RATE_HZ", "NOTE_SAMPLES", "ORDER",
            "PASSBAND", "angle_columns", "decimate_arrays", "decimate_case", "decimate_record",
-           "decimation_note", "noise_band"]
+           "decimation_note", "noise_band", "slosh_band_factor"]
 
 #: Lowest rate a record may be decimated to [Hz] (a passband to 16 Hz).
 MIN_RATE_HZ = 40.0
@@ -142,15 +142,16 @@ def decimate_arrays(name: str, arrays: tuple, factor: int, problems: list[str],
 
 def decimate_case(case, factor: int, what: str = "decimate"):
     """``case`` with its record decimated by ``factor`` (as ``[test] decimate = factor``
-    would have read it; ``what`` names the request in the messages, e.g. ``--decimate``).
-    Raises :class:`~estimate.data.case.CaseError` when the record cannot take it or is
+    would have read it; ``what`` names the request in the messages, e.g. ``--decimate``;
+    ``factor`` 1: every sample, said by ``[test] decimate = 1``, which
+    :func:`slosh_band_factor` leaves alone). Raises :class:`~estimate.data.case.CaseError` when the record cannot take it or is
     decimated already."""
     from dataclasses import replace
 
     from .case import CaseError
 
-    if factor == 1:
-        return case
+    if factor == 1:  # every sample asked for: said, so nothing decimates it later
+        return case if case.test.decimate else replace(case, test=replace(case.test, decimate=1))
     if case.test.decimate and case.test.decimate > 1:
         raise CaseError([f"{case.path.name}: {what} {factor}: the case decimates its record "
                          f"by {case.test.decimate} already ([test] decimate); give one of them"])
@@ -169,21 +170,32 @@ def decimate_case(case, factor: int, what: str = "decimate"):
                    notes=(*case.notes, note))
 
 
-def decimation_note(case) -> str | None:
-    """A note for a long record sampled far above the slosh band that is fitted at its full
-    rate (no ``[test] decimate``): by how much to decimate it to about
-    :data:`NOTE_RATE_HZ`; ``None`` otherwise. A lateral rig only (the spinning rig's
-    records are fitted as they come)."""
+def slosh_band_factor(case) -> int | None:
+    """The factor that decimates ``case``'s record to about :data:`NOTE_RATE_HZ` when it is
+    long and sampled far above the slosh band: at least :data:`NOTE_SAMPLES` samples, a
+    factor of 2 or more that keeps ``[test] motion_band_hz`` in the passband and
+    :data:`MIN_SAMPLES` samples; ``None`` otherwise, for a record decimated already and on
+    the spinning rig (whose records are fitted as they come)."""
     if case.test.decimate is not None or case.test.rig != "lateral":
         return None
-    n = case.time.size
-    rate = case.sample_rate
+    n, rate = case.time.size, case.sample_rate
     factor = int(rate // NOTE_RATE_HZ)
     band = case.test.motion_band_hz
     if band is not None:
         factor = min(factor, int(PASSBAND * rate // band))
     if n < NOTE_SAMPLES or factor < 2 or n // factor < MIN_SAMPLES:
         return None
+    return factor
+
+
+def decimation_note(case) -> str | None:
+    """A note for a long record sampled far above the slosh band that is fitted at its full
+    rate (no ``[test] decimate``): by how much to decimate it to about
+    :data:`NOTE_RATE_HZ` (:func:`slosh_band_factor`); ``None`` otherwise."""
+    factor = slosh_band_factor(case)
+    if factor is None:
+        return None
+    n, rate = case.time.size, case.sample_rate
     return (f"{case.data_path.name}: {n} samples at {rate:.6g} Hz, far above the slosh band: "
             f"`[test] decimate = {factor}` (or --decimate {factor}) fits them at "
             f"{rate / factor:.6g} Hz in a fraction of the time and memory, with the same "

@@ -118,7 +118,8 @@ def force_cutoff(cases: Sequence[Case]) -> float:
 
 def diagnose(cases: Case | Sequence[Case], *, max_bic_change: float = MAX_BIC_CHANGE,
              max_rounds: int = 3, segments: int = 4,
-             force_cutoff_hz: float | None = None, progress: bool | None = None) -> Diagnosis:
+             force_cutoff_hz: float | None = None, progress: bool | None = None,
+             screen_decimated: bool = True) -> Diagnosis:
     """Diagnose the baseline analog on ``cases`` and extend it greedily.
 
     Parameters
@@ -136,39 +137,39 @@ def diagnose(cases: Case | Sequence[Case], *, max_bic_change: float = MAX_BIC_CH
         :func:`force_cutoff`.
     progress : bool, optional
         Show a bar counting the fits and naming the stage; default: on a terminal only.
+    screen_decimated : bool, default True
+        A long record sampled far above the slosh band
+        (:func:`~estimate.data.decimation.slosh_band_factor`: 10,000 samples or more at
+        200 Hz or more, on the lateral rig) is searched on a copy decimated to about 100 Hz;
+        only the baseline (from the prediction, as without it) and the final model (from
+        the search's estimates) are fitted on every sample. ``[test] decimate = 1`` or
+        ``False`` here: every fit on every sample.
     """
     from .._progress import progress as bar
 
     with bar(total=None, desc="diagnose", unit=" fits", enabled=progress) as b:
-        return _diagnose(cases, max_bic_change, max_rounds, segments, force_cutoff_hz, b)
+        return _diagnose(cases, max_bic_change, max_rounds, segments, force_cutoff_hz, b,
+                         screen_decimated)
 
 
 def _diagnose(cases, max_bic_change: float, max_rounds: int, segments: int,
-              force_cutoff_hz: float | None, bar) -> Diagnosis:
+              force_cutoff_hz: float | None, bar, screen_decimated: bool = True) -> Diagnosis:
     t0 = time.perf_counter()
     cases = [cases] if isinstance(cases, Case) else list(cases)
     lateral = all(c.test.rig == "lateral" for c in cases)
+    full_cases, cases, notes = cases, *_screening_cases(cases, screen_decimated)
     # estimated input on the lateral rig (the residual floor is then the noise); the
     # spinning rig's motion is prescribed, its six channels fitted filtered
+    cutoff = force_cutoff_hz or force_cutoff(full_cases)
     fitter = Fitter(cases, [holdout_weights(c.time.size) for c in cases],
-                    "estimated" if lateral else "filtered",
-                    force_cutoff_hz or force_cutoff(cases), bar)
+                    "estimated" if lateral else "filtered", cutoff, bar)
     model = baseline_model(cases[0])
     bar.set_postfix_str("baseline")
-    base = fitter(model, (), {}, purpose="baseline")
-    if not base.converged:
-        # a lightly damped start next to a resonance can swing over the top: restart damped
-        g = cases[0].rig.gravity
-        m, L = (base.problem.initial[base.names.index(n)] for n in ("p1.mass", "p1.length"))
-        again = fitter(model, (), {"p1.damping": 2 * 0.05 * m * L**2 * math.sqrt(g / L)},
-                       purpose="baseline, damped restart")
-        if (again.converged, -again.objective) > (base.converged, -base.objective):
-            base = again  # else the first attempt, closer to the data, stays the baseline
+    base = _baseline(fitter, model)
     segs = segment_damping(base, n_segments=segments)
     fitter.extra += len(segs)
     evidence = base_evidence = collect_evidence(base, segments=segs)
     predicted = predicted_values(cases[0], model + Pendulum("p2"))
-    notes = _bound_notes("baseline", base)
     if cases[0].tank.diaphragm:
         notes.append("the case file says the tank has a diaphragm; the diagnosis starts from the "
                      "free-surface analog and looks for the diaphragm's signature in the data")
@@ -189,6 +190,18 @@ def _diagnose(cases, max_bic_change: float, max_rounds: int, segments: int,
         # the segment refits (amplitude trends) are made when a candidate needs them
         evidence = collect_evidence(current, segments=())
     bar.set_postfix_str("final fit")
+    search = fitter
+    if full_cases is not cases:
+        fitter = Fitter(full_cases, [holdout_weights(c.time.size) for c in full_cases],
+                        fitter.input, cutoff, bar)
+        fitter.held, fitter.started = dict(search.held), search.started
+        # from the prediction, as without the screening: the decimated baseline's
+        # estimates were no better a start (60 s, 500 Hz hardware-like record of
+        # benchmarks/bench_diagnose.py: 21 iterations, 8.4 s from them, 23, 7.6 s cold)
+        base = _baseline(fitter, model, " (every sample)")
+        base_evidence = collect_evidence(base, segments=segs)
+        fitter.log[:0], fitter.extra = search.log, search.extra
+    notes += _bound_notes("baseline", base)
     # a candidate's bounds stay; the first mode's stability bounds of a cold start do not
     bounds = {e.name: (e.lower, e.upper) for e in current.problem.estimated
               if e.case is None and e.name not in ("p1.mass", "p1.damping")}
@@ -205,9 +218,9 @@ def _diagnose(cases, max_bic_change: float, max_rounds: int, segments: int,
     for fam in FAMILIES:
         final, note = fam.finish(fitter, final)
         notes += [note] if note else []
-    if fitter.time_left() <= 0:
-        notes.append(f"the diagnosis's time budget ({fitter.budget:.0f} s of CPU time for "
-                     f"{fitter.samples} samples) was spent: candidates not yet fitted were not "
+    if search.time_left() <= 0:
+        notes.append(f"the diagnosis's time budget ({search.budget:.0f} s of CPU time for "
+                     f"{search.samples} samples) was spent: candidates not yet fitted were not "
                      "tried (see the candidates table)")
     final_evidence = collect_evidence(final, segments=evidence.segments)
     verdict = Verdict.of(final_evidence, tuple(rounds), tuple(findings))
@@ -216,6 +229,39 @@ def _diagnose(cases, max_bic_change: float, max_rounds: int, segments: int,
     return Diagnosis(base, base_evidence.against(final_evidence.noise), tuple(findings), final,
                      final_evidence, tuple(rounds), fitter.count, time.perf_counter() - t0, tuple(notes),
                      verdict, tuple(fitter.log))
+
+
+def _screening_cases(cases: list[Case], decimated: bool) -> tuple[list[Case], list[str]]:
+    """The cases the diagnosis's search fits: ``cases``, or (``decimated``) those that are
+    long and sampled far above the slosh band decimated to about 100 Hz
+    (:func:`~estimate.data.decimation.slosh_band_factor`), with a note saying so."""
+    from ..data.decimation import decimate_case, slosh_band_factor
+
+    factors = [slosh_band_factor(c) if decimated else None for c in cases]
+    if not any(factors):
+        return cases, []
+    out = [decimate_case(c, k, "the diagnosis's screening") if k else c
+           for c, k in zip(cases, factors)]
+    which = "; ".join(f"{c.data_path.name} by {k} ({c.sample_rate:.6g} -> "
+                      f"{c.sample_rate / k:.6g} Hz)" for c, k in zip(cases, factors) if k)
+    return out, [f"the candidates were screened and fitted on the record decimated to the slosh "
+                 f"band ({which}; their residuals in the candidates table are the decimated "
+                 f"record's); the baseline and the final model are fitted on every sample"]
+
+
+def _baseline(fitter: Fitter, model: Model, what: str = "") -> FitResult:
+    """The baseline fit of ``fitter``'s cases from the prediction; when it does not
+    converge, again from a damped start (a lightly damped start next to a resonance can
+    swing over the top), the better of the two kept."""
+    base = fitter(model, (), {}, purpose="baseline" + what)
+    if not base.converged:
+        g = fitter.cases[0].rig.gravity
+        m, L = (base.problem.initial[base.names.index(n)] for n in ("p1.mass", "p1.length"))
+        again = fitter(model, (), {"p1.damping": 2 * 0.05 * m * L**2 * math.sqrt(g / L)},
+                       purpose=f"baseline{what}, damped restart")
+        if (again.converged, -again.objective) > (base.converged, -base.objective):
+            base = again  # else the first attempt, closer to the data, stays the baseline
+    return base
 
 
 def _bound_notes(label: str, res: FitResult) -> list[str]:
