@@ -144,8 +144,8 @@ def decimate_case(case, factor: int, what: str = "decimate"):
     """``case`` with its record decimated by ``factor`` (as ``[test] decimate = factor``
     would have read it; ``what`` names the request in the messages, e.g. ``--decimate``;
     ``factor`` 1: every sample, said by ``[test] decimate = 1``, which
-    :func:`slosh_band_factor` leaves alone). Raises :class:`~estimate.data.case.CaseError` when the record cannot take it or is
-    decimated already."""
+    :func:`slosh_band_factor` leaves alone). Raises :class:`~estimate.data.case.CaseError`
+    when the record cannot take it or is decimated already."""
     from dataclasses import replace
 
     from .case import CaseError
