@@ -103,11 +103,12 @@ def _quantities(result) -> tuple[dict[str, list], dict[str, list]]:
 
 
 def _fit(task: Task) -> dict[str, Any]:
+    from ..data.decimation import slosh_band_decimated
     from ..data.models import model_from_spec
     from ..fitting.nlp import fit
     from ..fitting.problem import FitProblem
 
-    cases = task.cases
+    cases = [slosh_band_decimated(c) for c in task.cases]  # as `slosh fit` does
     model = model_from_spec(task.model, cases[0])
     result = fit(FitProblem.build(cases, model, input=task.input), progress=False)
     params, derived = _quantities(result)

@@ -29,7 +29,8 @@ def add_force(parser) -> None:
 
 def load_cases(paths: Sequence[str], *, prediction: bool = False, strict: bool = False,
                motion_band_hz: float | None = None, shared: bool = False,
-               decimate: int | None = None) -> tuple[list["Case"], list[str]]:
+               decimate: int | None = None, slosh_band: bool = False
+               ) -> tuple[list["Case"], list[str]]:
     """The cases of ``paths`` and warnings about them (``strict``: unknown keys are errors,
     :func:`estimate.data.load_case`).
 
@@ -40,7 +41,9 @@ def load_cases(paths: Sequence[str], *, prediction: bool = False, strict: bool =
     the cases are fitted with shared parameters, so records of different tanks, fills or
     liquids are refused (:func:`estimate.data.records.refuse_mixed`); ``decimate``
     (``--decimate``) decimates every case's record as ``[test] decimate`` would
-    (:func:`estimate.data.decimation.decimate_case`).
+    (:func:`estimate.data.decimation.decimate_case`); without it, ``slosh_band``
+    decimates a long record sampled far above the slosh band to about 100 Hz
+    (:func:`estimate.data.decimation.slosh_band_decimated`: ``slosh fit``'s default).
     """
     from ..data import load_case
     from ..data.records import refuse_mixed, refuse_repeated
@@ -52,6 +55,10 @@ def load_cases(paths: Sequence[str], *, prediction: bool = False, strict: bool =
         from ..data.decimation import decimate_case
 
         cases = [decimate_case(c, decimate, "--decimate") for c in cases]
+    elif slosh_band:
+        from ..data.decimation import slosh_band_decimated
+
+        cases = [slosh_band_decimated(c) for c in cases]
     refuse_repeated(cases)
     if shared:
         refuse_mixed(cases)
@@ -83,10 +90,10 @@ def add_decimate(parser) -> None:
                         help="fit every K-th sample of each record after a zero-phase "
                              "anti-alias low-pass, as the case key [test] decimate = K does "
                              "(a record sampled far above the slosh band fits in a fraction "
-                             "of the time and memory; the new rate must be >= 40 Hz); "
-                             "1: every sample, also in the diagnosis's search, which "
-                             "otherwise screens a long record sampled far above the slosh "
-                             "band decimated to about 100 Hz")
+                             "of the time and memory; the new rate must be >= 40 Hz). "
+                             "Default: a record of 10,000 samples or more at 200 Hz or more "
+                             "is fitted (diagnose: searched) at about 100 Hz; 1 keeps "
+                             "every sample")
 
 
 def positive_hz(text: str) -> float:

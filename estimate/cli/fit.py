@@ -90,7 +90,7 @@ def run(args: argparse.Namespace) -> int:
     outputs.file("--report", report_file).check()
     cases, notes = load_cases(args.cases, prediction=True, strict=args.strict,
                               motion_band_hz=args.motion_band, shared=True,
-                              decimate=args.decimate)
+                              decimate=args.decimate, slosh_band=True)
     for w in notes:  # before the fit, which starts from [prediction]
         print(f"warning: {w}", file=sys.stderr)
     spec = BASELINE if args.model is None else args.model

@@ -162,3 +162,45 @@ def test_a_case_decimated_twice_is_refused(tmp_path, capsys):
     assert ("A1.toml: --decimate 2: the case decimates its record by 2 already ([test] "
             "decimate); give one of them") in capsys.readouterr().err
 
+
+
+def _fast_record(tmp_path):
+    """20 s at 500 Hz from rest (10,001 samples): a 1 mm sweep across the 8-inch sphere's
+    first mode, 1.3 % force noise, 20 um displacement noise (the reference simulator)."""
+    import reference_models as ref
+    from synthetic_cases import G, make_case, pendulum
+
+    p = pendulum(1.30, 0.0553, 0.01)
+    f1 = ref.natural_frequency(p, G) / (2 * np.pi)
+    drive = ref.Ramped(ref.LinearSweep(0.001, 0.6 * f1, 1.6 * f1, 20.0), 1.5, 0.0)
+    case, _ = make_case(tmp_path, "F", drive, pendulums=[p], fixed_mass=1.5, dry_mass=1.2,
+                        noise=0.013, displacement_noise=2e-5, duration=20.0, rate=500.0,
+                        seed=21)
+    return case
+
+
+def test_slosh_fit_decimates_a_long_fast_record_by_default_and_says_so(tmp_path, capsys):
+    """10,001 samples at 500 Hz: ``slosh fit`` fits them at 100 Hz (the fit record's noise
+    at 100 Hz, a note naming the default and how to keep every sample); ``--decimate 1``
+    fits every sample at 500 Hz (asked for: not told to decimate); the slosh mass's estimates
+    agree within a standard error. A1 itself (3,001 samples at 100 Hz) is fitted as it is
+    (``test_slosh_fit_decimates_on_request_and_says_so``, the README's quick start)."""
+    import json
+
+    from estimate.cli import main
+
+    case = _fast_record(tmp_path)
+    fits = {}
+    for extra, rate in (([], 100.0), (["--decimate", "1"], 500.0)):
+        out = tmp_path / f"fit{rate:g}.json"
+        assert main(["fit", str(case.path), "--json", str(out), *extra]) == 0
+        data = fits[rate] = json.loads(out.read_text())
+        assert [n["sample_rate_hz"] for n in data["noise"]] == [pytest.approx(rate)]
+        said = [n for n in data["notes"] if "F.csv: decimated by 5 for the fit (by default" in n]
+        told = [n for n in data["notes"] if "far above the slosh band: `[test] decimate = 5`" in n]
+        assert (len(said), len(told)) == ((1, 0) if rate == 100.0 else (0, 0)), data["notes"]
+        assert data["converged"]
+    capsys.readouterr()
+    dec, full = (fits[r]["parameters"]["p1.mass"] for r in (100.0, 500.0))
+    assert abs(dec["value"] - full["value"]) < full["stderr"], (dec, full)
+    assert abs(dec["value"] - 1.30) < 2 * dec["stderr"], dec
