@@ -46,9 +46,12 @@ def load_cases(paths: Sequence[str], *, prediction: bool = False, strict: bool =
     (:func:`estimate.data.decimation.slosh_band_decimated`: ``slosh fit``'s default).
     """
     from ..data import load_case
+    from ..data.decimation import READ_ALLOWANCE
     from ..data.records import refuse_mixed, refuse_repeated
 
-    cases = [load_case(p, strict=strict) for p in paths]
+    # the budget counts the samples the command keeps
+    allowance = decimate or (READ_ALLOWANCE if slosh_band else 1)
+    cases = [load_case(p, strict=strict, allowance=allowance) for p in paths]
     if motion_band_hz is not None:
         cases = [replace(c, test=replace(c.test, motion_band_hz=motion_band_hz)) for c in cases]
     if decimate is not None:

@@ -30,8 +30,9 @@ from __future__ import annotations
 import numpy as np
 
 __all__ = ["FLAT", "MIN_RATE_HZ", "MIN_SAMPLES", "NOTE_RATE_HZ", "NOTE_SAMPLES", "ORDER",
-           "PASSBAND", "angle_columns", "decimate_arrays", "decimate_case", "decimate_record",
-           "decimation_note", "noise_band", "slosh_band_decimated", "slosh_band_factor"]
+           "PASSBAND", "READ_ALLOWANCE", "angle_columns", "decimate_arrays", "decimate_case",
+           "decimate_record", "decimation_note", "noise_band", "slosh_band_decimated",
+           "slosh_band_factor"]
 
 #: Lowest rate a record may be decimated to [Hz] (a passband to 16 Hz).
 MIN_RATE_HZ = 40.0
@@ -193,6 +194,9 @@ def slosh_band_factor(case) -> int | None:
     return factor
 
 
+#: How many times the memory budget's samples a command that decimates by default reads
+#: (``load_case(allowance=)``): a 1 kHz record decimated to :data:`NOTE_RATE_HZ`.
+READ_ALLOWANCE = 10
 #: What the note of a record decimated by default (:func:`slosh_band_decimated`) calls it.
 DEFAULT_WHAT = ("by default, a long record sampled far above the slosh band; "
                 "--decimate 1 or [test] decimate = 1 fits every sample")

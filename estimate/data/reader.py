@@ -31,7 +31,8 @@ def _not_a_file(path: Path) -> str | None:
     return file_kind(path)
 
 
-def load_case(path: str | os.PathLike[str], *, strict: bool = False) -> Case:
+def load_case(path: str | os.PathLike[str], *, strict: bool = False,
+              allowance: int = 1) -> Case:
     """Load and validate a test case (TOML file plus the CSV, TDMS, MAT or HDF5 file it names).
 
     The case file must be a regular file of at most :data:`MAX_CASE_FILE_BYTES` bytes nested
@@ -47,6 +48,12 @@ def load_case(path: str | os.PathLike[str], *, strict: bool = False) -> Case:
         The TOML case file.
     strict : bool, default False
         Unknown keys and tables are errors instead of warnings (``--strict``).
+    allowance : int, default 1
+        The command decimates the record by up to this factor before it fits it (``slosh
+        fit``'s default for a long lateral record sampled far above the slosh band,
+        ``--decimate K``): the record may hold that many times more samples than the
+        memory budget allows a fit (:mod:`estimate.data.budget`); the fit checks the budget
+        again on the samples it keeps. ``[test] decimate`` sets it for its own record.
 
     Returns
     -------
@@ -129,20 +136,22 @@ def load_case(path: str | os.PathLike[str], *, strict: bool = False) -> Case:
             uniform = not (isinstance(t_table, Mapping) and "resample_hz" in t_table)
             # a decimated record is read with as many more samples as it keeps fewer
             factor = test.decimate if test is not None and test.decimate else 1
+            # what the budget admits: the case's own decimation, or the command's
+            read = factor if test is None or test.decimate is not None else max(allowance, 1)
             if lab and motion is not None:
                 csv_problems.append(f"{fname}: [rig.motion]: a six-axis record is read from a "
                                     f"CSV file (`time`, the motion columns, the channels); "
                                     f"found {what} (export it to CSV)")
             elif lab:
                 arrays = read_lab(data_path, fname, doc, excitation, rig_kind, rig, csv_problems,
-                                  uniform=uniform, unitless=unitless, decimate=factor)
+                                  uniform=uniform, unitless=unitless, decimate=read)
             else:
                 arrays = read_csv(data_path, excitation, csv_problems, rig_kind, uniform=uniform,
-                                  motion=motion, decimate=factor)
+                                  motion=motion, decimate=read)
             problems.extend(csv_problems)
             if arrays is not None and test is not None and test.resample_hz is not None:
                 arrays, note = _uniform(data_path.name, arrays, test.resample_hz, problems,
-                                        factor)
+                                        read)
                 notes.append(note)
             if arrays is not None and factor > 1:
                 from .decimation import decimate_arrays

@@ -204,3 +204,22 @@ def test_slosh_fit_decimates_a_long_fast_record_by_default_and_says_so(tmp_path,
     dec, full = (fits[r]["parameters"]["p1.mass"] for r in (100.0, 500.0))
     assert abs(dec["value"] - full["value"]) < full["stderr"], (dec, full)
     assert abs(dec["value"] - 1.30) < 2 * dec["stderr"], dec
+
+
+def test_the_budget_counts_the_samples_slosh_fit_keeps(tmp_path, monkeypatch, capsys):
+    """64 MiB admit 4096 samples. The 10,001-sample, 500 Hz record: ``slosh fit`` decimates
+    it to 2,001 by default, so it is read and fitted; ``--decimate 1`` (every sample) and
+    ``slosh diagnose`` (its final fit takes every sample) refuse it before reading a row,
+    naming the factor that would fit; ``--decimate 5`` reads it."""
+    from estimate.cli import main
+
+    case = _fast_record(tmp_path)
+    monkeypatch.setenv("SLOSH_MEMORY_BUDGET", "64M")
+    assert main(["fit", str(case.path), "--decimate", "1"]) == 2
+    assert "F.csv: rows: 10001 samples; " in capsys.readouterr().err
+    assert main(["diagnose", str(case.path), "--json", str(tmp_path / "d.json")]) == 2
+    assert "`[test] decimate = 3`" in capsys.readouterr().err
+    out = tmp_path / "fit.json"
+    for extra in ([], ["--decimate", "5"]):
+        assert main(["fit", str(case.path), "--json", str(out), "--overwrite", *extra]) == 0
+        assert "10001 -> 2001 samples" in capsys.readouterr().out
