@@ -223,3 +223,16 @@ def test_the_budget_counts_the_samples_slosh_fit_keeps(tmp_path, monkeypatch, ca
     for extra in ([], ["--decimate", "5"]):
         assert main(["fit", str(case.path), "--json", str(out), "--overwrite", *extra]) == 0
         assert "10001 -> 2001 samples" in capsys.readouterr().out
+
+
+def test_a_campaign_fits_a_long_fast_record_as_slosh_fit_does(tmp_path):
+    """A campaign's fit of the 10,001-sample, 500 Hz record fits its 2,001 samples at
+    100 Hz, as ``slosh fit`` does, and finds the slosh mass within two standard errors."""
+    from estimate.campaign.tasks import Task, run_task
+
+    case = _fast_record(tmp_path)
+    out = run_task(Task("fit", "k", "record F", (case,), "fixed,p1"))
+    assert out["status"] == "ok", out
+    assert out["samples"] == 2001
+    value, stderr = out["parameters"]["p1.mass"][:2]
+    assert abs(value - 1.30) < 2 * stderr, (value, stderr)
