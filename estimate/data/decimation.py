@@ -175,18 +175,21 @@ def slosh_band_factor(case) -> int | None:
     """The factor that decimates ``case``'s record to about :data:`NOTE_RATE_HZ` when it is
     long and sampled far above the slosh band: at least :data:`NOTE_SAMPLES` samples, a
     factor of 2 or more that keeps the carriage motion (``[test] motion_band_hz``, else
-    the displacement's :func:`~estimate.data.signals.motion_band`) below :data:`FLAT` of
-    the new rate and :data:`MIN_SAMPLES` samples; ``None`` otherwise, for a record decimated already and on
+    the measured displacement's :func:`~estimate.data.signals.motion_band`; a record
+    without one, six-axis or crank-driven, is left alone) below :data:`FLAT` of the new
+    rate and :data:`MIN_SAMPLES` samples; ``None`` otherwise, for a record decimated already and on
     the spinning rig (whose records are fitted as they come)."""
     if case.test.decimate is not None or case.test.rig != "lateral":
         return None
     n, rate = case.time.size, case.sample_rate
     factor = int(rate / NOTE_RATE_HZ * (1 + 1e-9))  # a 500 Hz record's rate is 499.99..
     band = case.test.motion_band_hz
-    if band is None and case.displacement is not None:
+    if band is None and case.displacement is not None and not case.columns:
         from .signals import motion_band
 
         band = motion_band(case.time, case.displacement)
+    elif band is None:  # a six-axis or crank record: its motion's band is not read here
+        return None
     if band:  # the carriage motion inside the flat band (nobody asked for this factor)
         factor = min(factor, int(FLAT * rate / band))
     if n < NOTE_SAMPLES or factor < 2 or n // factor < MIN_SAMPLES:

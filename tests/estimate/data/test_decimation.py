@@ -236,3 +236,26 @@ def test_a_campaign_fits_a_long_fast_record_as_slosh_fit_does(tmp_path):
     assert out["samples"] == 2001
     value, stderr = out["parameters"]["p1.mass"][:2]
     assert abs(value - 1.30) < 2 * stderr, (value, stderr)
+
+
+def test_only_a_record_whose_motion_band_is_known_is_decimated_by_default(tmp_path):
+    """The 10,001-sample, 500 Hz sweep (its displacement's band about 2 Hz): by 5 to 100 Hz;
+    a 25 s, 500 Hz six-axis record (12,501 samples; its motion is in columns whose band is
+    not read): left as it is. ``[test] motion_band_hz`` keeps the motion inside the flat
+    0.3 of the new rate: 20 Hz leaves 5 (0.3 x 100 Hz = 30 Hz), 40 Hz allows 3 (50 Hz;
+    4 would leave 37.5 Hz)."""
+    from dataclasses import replace
+
+    import reference_motion as rm
+    from motion_cases import PENDULUM, make_motion_case
+
+    from estimate.data.decimation import slosh_band_factor
+
+    case = _fast_record(tmp_path)
+    assert slosh_band_factor(case) == 5
+    motion = rm.Motion(x=rm.RampedSine(0.002, PENDULUM.frequency_hz(), ramp=1.5, start=0.5))
+    six, _ = make_motion_case(tmp_path, "six", motion, duration=25.0, rate=500.0, seed=4)
+    assert six.time.size == 12501 and slosh_band_factor(six) is None
+    for band, factor in ((20.0, 5), (40.0, 3)):
+        banded = replace(case, test=replace(case.test, motion_band_hz=band))
+        assert slosh_band_factor(banded) == factor, band
