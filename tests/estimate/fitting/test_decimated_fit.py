@@ -42,26 +42,21 @@ def test_a_decimated_fit_keeps_the_estimates_and_their_standard_errors(tmp_path)
 
 
 def test_a_long_fast_record_is_told_how_to_decimate(tmp_path):
-    """A1 (30 s) resampled at 500 Hz, 15,001 samples: the fit's notes propose ``[test]
-    decimate = 5``; at its own 100 Hz, or with ``decimate = 1`` (every sample asked for),
-    nothing is said."""
+    """20 s at 500 Hz from rest (10,001 samples, the reference simulator): the fit's notes
+    propose ``[test] decimate = 5``; with ``decimate = 1`` (every sample asked for) nothing
+    is said, nor for a record at 100 Hz (A1)."""
     from dataclasses import replace
     from pathlib import Path
 
-    from scipy.interpolate import CubicSpline
-
-    from estimate import write_case
-
-    examples = Path(__file__).resolve().parents[3] / "examples"
-    a1 = load_case(examples / "A1.toml")
-    t = np.arange(15001) / 500.0
-    args = dict(tank=a1.tank, liquid=a1.liquid, rig=a1.rig, time=t,
-                force=CubicSpline(a1.time, a1.force)(t),
-                displacement=CubicSpline(a1.time, a1.displacement)(t), prediction=a1.prediction)
-    fast = write_case(tmp_path / "F.toml", test=replace(a1.test, id="F", data="F.csv"), **args)
-    kept = write_case(tmp_path / "K.toml", test=replace(a1.test, id="K", data="K.csv",
-                                                        decimate=1), **args)
-    hint = ("F.csv: 15001 samples at 500 Hz, far above the slosh band: `[test] decimate = 5` "
+    p = pendulum(1.30, 0.0553, 0.01)
+    f1 = ref.natural_frequency(p, G) / (2 * np.pi)
+    drive = ref.Ramped(ref.LinearSweep(0.001, 0.6 * f1, 1.6 * f1, 20.0), 1.5, 0.0)
+    fast, _ = make_case(tmp_path, "F", drive, pendulums=[p], fixed_mass=1.5, dry_mass=1.2,
+                        noise=0.013, displacement_noise=2e-5, duration=20.0, rate=500.0,
+                        seed=5)
+    kept = replace(fast, test=replace(fast.test, decimate=1))
+    a1 = load_case(Path(__file__).resolve().parents[3] / "examples" / "A1.toml")
+    hint = ("F.csv: 10001 samples at 500 Hz, far above the slosh band: `[test] decimate = 5` "
             "(or --decimate 5) fits them at 100 Hz")
     model = model_from_spec("fixed,p1", fast)
     assert any(hint in n for n in FitProblem.build(fast, model, first_stage=False).notes)
