@@ -207,6 +207,21 @@ def _model_text(res: FitResult) -> str:
     return " + ".join(res.problem.model.names)
 
 
+def _as_recorded(res: FitResult, t: np.ndarray, simulated: np.ndarray) -> np.ndarray:
+    """``res``'s simulated force on the record's time axis: a sensor delay's fit compares
+    the model with the recorded force advanced by the delay
+    (:class:`~estimate.fitting.measurement.SensorDelay`), so its simulation is drawn that
+    much later, as the transducer records it (NaN before the delay); else unchanged. Drawn
+    at the samples' own times it ran a delay ahead of the measured curve (23.7 ms on a 2 Hz
+    swing) while its residual was at the noise."""
+    from ..fitting.measurement import SensorDelay
+
+    delay = sum(m.delay for m in res.problem.measurement if isinstance(m, SensorDelay))
+    if not delay:
+        return simulated
+    return np.interp(t, t + delay, simulated, left=np.nan)
+
+
 def before_after_figure(d: Diagnosis, path: str | Path | None = None):
     """The diagnosis ``d``'s measured force with the baseline's and the final model's simulation (zooms on the
     start-up and the steady end), and the two residuals on their own, shared axis in N
@@ -217,7 +232,8 @@ def before_after_figure(d: Diagnosis, path: str | Path | None = None):
     shown = _Shown.of(d.baseline, d.baseline_evidence.channel_share)
     unit = shown.unit
     meas = shown.column(d.baseline.measured[0])
-    base, final = shown.column(d.baseline.simulated(0)), shown.column(d.final.simulated(0))
+    base, final = (_as_recorded(r, t, shown.column(r.simulated(0)))
+                   for r in (d.baseline, d.final))
     # the baseline's simulation in its held-out blocks follows a carriage motion read off
     # the displacement alone: shaded and left blank, as in its residual panel
     held_base = (d.baseline.weights[0] == 0) if d.baseline.weights else np.zeros(t.size, bool)
