@@ -23,6 +23,15 @@ records the model explains, or keep every sample where the last digit of precisi
 
 The new rate must keep the slosh band well inside the passband: at least
 :data:`MIN_RATE_HZ`, and the passband above ``[test] motion_band_hz`` when that is given.
+
+Without the key, ``slosh fit`` and a campaign's fits decimate a long lateral record sampled
+far above the slosh band to about :data:`NOTE_RATE_HZ` (:func:`slosh_band_decimated`,
+``[test] decimate = 1`` or ``--decimate 1`` keeps every sample; measured, the intervals
+came out the same to 5 % or wider, and a 10-minute, 1 kHz record fits in 1 GB instead of
+5), and the
+diagnosis searches such a record decimated and fits its baseline and final model on every
+sample (:func:`estimate.diagnosis.search.diagnose`). The Python ``fit()`` fits a case as it
+is and says in its notes by how much to decimate (:func:`decimation_note`).
 """
 
 from __future__ import annotations
@@ -177,8 +186,8 @@ def slosh_band_factor(case) -> int | None:
     factor of 2 or more that keeps the carriage motion (``[test] motion_band_hz``, else
     the measured displacement's :func:`~estimate.data.signals.motion_band`; a record
     without one, six-axis or crank-driven, is left alone) below :data:`FLAT` of the new
-    rate and :data:`MIN_SAMPLES` samples; ``None`` otherwise, for a record decimated already and on
-    the spinning rig (whose records are fitted as they come)."""
+    rate and :data:`MIN_SAMPLES` samples; ``None`` otherwise, for a record that says
+    ``[test] decimate`` and on the spinning rig (whose records are fitted as they come)."""
     if case.test.decimate is not None or case.test.rig != "lateral":
         return None
     n, rate = case.time.size, case.sample_rate
