@@ -93,10 +93,11 @@ def size_text(n_bytes: float) -> str:
 
 def decimation_hint(samples: int, decimate: int = 1) -> str:
     """What to do with a record of ``samples`` samples over the budget (``decimate``: the
-    ``[test] decimate`` it is read with)."""
+    factor it is read for, its ``[test] decimate`` or the command's default decimation)."""
     limit = max_samples()
     factor = math.ceil(samples / limit)
-    now = f" (now {decimate})" if decimate > 1 else ""
+    now = (f" (it was read for a fit of every {decimate}{_ordinal(decimate)} sample)"
+           if decimate > 1 else "")
     return (f"a fit needs about {size_text(FIT_BYTES_PER_SAMPLE)} per sample "
             f"({size_text(samples / decimate * FIT_BYTES_PER_SAMPLE)}), over the memory budget "
             f"of {size_text(memory_budget())} (at most {limit} samples; set {BUDGET_VARIABLE} "

@@ -259,3 +259,18 @@ def test_only_a_record_whose_motion_band_is_known_is_decimated_by_default(tmp_pa
     for band, factor in ((20.0, 5), (40.0, 3)):
         banded = replace(case, test=replace(case.test, motion_band_hz=band))
         assert slosh_band_factor(banded) == factor, band
+
+
+def test_a_record_over_what_the_default_decimation_admits_is_refused_by_its_rows(
+        tmp_path, monkeypatch):
+    """32 MiB admit 2048 samples; ``slosh fit`` reads up to 10 times that for its default
+    decimation: A1's 3001 samples load with that allowance, and a refusal past it names the
+    factor to decimate by and what the record was read for (not a case key it lacks)."""
+    monkeypatch.setenv("SLOSH_MEMORY_BUDGET", "32M")
+    assert load_case(_case(tmp_path, ""), allowance=10).time.size == 3001
+    monkeypatch.setenv("SLOSH_MEMORY_BUDGET", "2M")  # 128 samples, 1280 with the allowance
+    with pytest.raises(CaseError) as info:
+        load_case(_case(tmp_path, ""), allowance=10)
+    text = str(info.value)
+    assert "A1.csv: rows: 3001 samples" in text and "`[test] decimate = 24`" in text
+    assert "(it was read for a fit of every 10th sample)" in text
