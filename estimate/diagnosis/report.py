@@ -204,7 +204,16 @@ def _drive_text(ev) -> str:
 
 
 def _model_text(res: FitResult) -> str:
-    return " + ".join(res.problem.model.names)
+    delay = _delay(res)
+    late = f", force read {1e3 * delay:.3g} ms late" if delay else ""
+    return " + ".join(res.problem.model.names) + late
+
+
+def _delay(res: FitResult) -> float:
+    """The sensor delay (s) of ``res``'s measurement models (0 without one)."""
+    from ..fitting.measurement import SensorDelay
+
+    return sum(m.delay for m in res.problem.measurement if isinstance(m, SensorDelay))
 
 
 def _as_recorded(res: FitResult, t: np.ndarray, simulated: np.ndarray) -> np.ndarray:
@@ -214,9 +223,7 @@ def _as_recorded(res: FitResult, t: np.ndarray, simulated: np.ndarray) -> np.nda
     much later, as the transducer records it (NaN before the delay); else unchanged. Drawn
     at the samples' own times it ran a delay ahead of the measured curve (23.7 ms on a 2 Hz
     swing) while its residual was at the noise."""
-    from ..fitting.measurement import SensorDelay
-
-    delay = sum(m.delay for m in res.problem.measurement if isinstance(m, SensorDelay))
+    delay = _delay(res)
     if not delay:
         return simulated
     return np.interp(t, t + delay, simulated, left=np.nan)
@@ -285,8 +292,9 @@ def before_after_figure(d: Diagnosis, path: str | Path | None = None):
         for i, (lo, hi) in enumerate(_runs(t, held)):
             a.axvspan(lo, hi, color="#fee08b", alpha=0.5, lw=0, zorder=0,
                       label="held out of this fit (not shown)" if i == 0 else None)
-            a.text(0.5 * (lo + hi), 0.0, "held out", ha="center", va="center", fontsize="small",
-                   color="0.35")
+            if hi - lo > 0.03 * (t[-1] - t[0]):  # a sensor delay's unmatched tail: shaded
+                a.text(0.5 * (lo + hi), 0.0, "held out", ha="center", va="center",
+                       fontsize="small", color="0.35")
         style.mark_startup(a, t, np.abs(np.nan_to_num(r)), end, limit, unit)
         rms = float(np.sqrt(np.mean(resid[fitted(res)] ** 2)))
         a.set(ylabel=f"residual [{unit}]", ylim=(-limit, limit))
