@@ -39,12 +39,13 @@ def record(tmp_path_factory):
 
 def test_the_search_runs_decimated_and_the_final_model_on_every_sample(record):
     """20 s at 500 Hz (10,001 samples): the candidates are fitted on 2,001 samples (decimated
-    by 5 to 100 Hz), the baseline
-    and the final fit on all 10,001; the stream lag is named and the final intervals of the
-    dry mass, slosh mass and length cover the truth (the transducer's 60 Hz low-pass adds
-    3.7 ms to the 20 ms lag: 23.7 ms is what the force stream really lags).
+    by 5 to 100 Hz), the baseline and the final fit on all 10,001; the stream lag is named
+    and the final intervals of the dry mass, slosh mass and length cover the truth (the
+    transducer's 60 Hz low-pass adds 3.7 ms to the 20 ms lag: 23.7 ms is what the force
+    stream really lags).
 
-    Without the screening every fit ran on every sample: 53.5 s against 8-12 s here."""
+    This record takes about as long either way (11 s); the 60 s one of
+    ``benchmarks/bench_diagnose.py`` took 308 s on every sample, 26-31 s screened."""
     d = diagnose(record, progress=False)
     assert [f.cause for f in d.findings] == ["sensor_delay"], d.findings
     assert not d.unexplained, d.verdict
@@ -78,8 +79,9 @@ def _drawn_as_recorded(d):
 
 
 def test_every_sample_when_asked(record):
-    """``[test] decimate = 1`` (``--decimate 1``) asks for every sample: the search is not
-    decimated, and the case says so to every later step."""
+    """``[test] decimate = 1`` (``--decimate 1``) asks for every sample: the case says so,
+    and :func:`slosh_band_factor` (the diagnosis's search, ``slosh fit``'s default) then
+    leaves it alone."""
     from estimate.data.decimation import slosh_band_factor
 
     assert slosh_band_factor(record) == 5
