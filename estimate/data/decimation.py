@@ -160,11 +160,11 @@ def decimate_case(case, factor: int, what: str = "decimate"):
 
     from .case import CaseError
 
-    if factor == 1:  # every sample asked for: said, so nothing decimates it later
-        return case if case.test.decimate else replace(case, test=replace(case.test, decimate=1))
     if case.test.decimate and case.test.decimate > 1:
         raise CaseError([f"{case.path.name}: {what} {factor}: the case decimates its record "
                          f"by {case.test.decimate} already ([test] decimate); give one of them"])
+    if factor == 1:  # every sample asked for: said, so nothing decimates it later
+        return replace(case, test=replace(case.test, decimate=1))
     problems: list[str] = []
     out = decimate_arrays(case.data_path.name, (case.time, case.displacement, case.force,
                                                 dict(case.columns)),

@@ -155,11 +155,14 @@ def test_slosh_fit_refuses_a_decimation_the_record_cannot_take(capsys):
             in capsys.readouterr().err)
 
 
-def test_a_case_decimated_twice_is_refused(tmp_path, capsys):
+@pytest.mark.parametrize("again", ["2", "1"])
+def test_a_case_decimated_twice_is_refused(tmp_path, capsys, again):
+    """``--decimate 2`` or ``--decimate 1`` (every sample) on a case that says ``[test]
+    decimate = 2``: refused, not one of them silently kept."""
     from estimate.cli import main
 
-    assert main(["fit", str(_case(tmp_path, "decimate = 2")), "--decimate", "2"]) == 2
-    assert ("A1.toml: --decimate 2: the case decimates its record by 2 already ([test] "
+    assert main(["fit", str(_case(tmp_path, "decimate = 2")), "--decimate", again]) == 2
+    assert (f"A1.toml: --decimate {again}: the case decimates its record by 2 already ([test] "
             "decimate); give one of them") in capsys.readouterr().err
 
 
