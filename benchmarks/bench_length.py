@@ -40,16 +40,10 @@ _MAKE = """
 import sys
 sys.path.insert(0, {root!r}); sys.path.append({tests!r})
 from pathlib import Path
-import numpy as np
-import reference_models as ref
-from synthetic_cases import G, make_case, pendulum
+from synthetic_cases import sweep_record
 from estimate.data.case import Prediction
-p = pendulum(1.30, 0.0553, 0.01)
-f1 = ref.natural_frequency(p, G) / (2 * np.pi)
-drive = ref.Ramped(ref.LinearSweep(0.001, 0.6 * f1, 1.6 * f1, {duration}), 1.5, 0.0)
-make_case(Path({folder!r}), {name!r}, drive, pendulums=[p], fixed_mass=1.5, dry_mass=1.2,
-          noise=0.013, displacement_noise=2e-5, duration={duration}, rate={rate}, seed=4,
-          prediction=Prediction(1.338, 0.057, 1.456, 0.007))
+sweep_record(Path({folder!r}), {name!r}, {duration}, rate={rate}, seed=4,
+             prediction=Prediction(1.338, 0.057, 1.456, 0.007))
 """
 
 _FIT = """

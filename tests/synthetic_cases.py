@@ -60,6 +60,22 @@ def pendulum(mass=1.30, length=0.0553, zeta=0.01, stiffness=0.0, quadratic_dampi
                         quadratic_damping)
 
 
+def sweep_record(folder: Path, name: str, duration: float, *, seed: int, rate: float = 500.0,
+                 **kw):
+    """A record from rest of a 1 mm sweep from 0.6 to 1.6 times the 8-inch sphere's first
+    mode (a 1.30 kg, 55.3 mm pendulum, 1 % damping; 1.5 kg fixed, 1.2 kg dry mass) over
+    ``duration`` s at ``rate`` Hz, with 1.3 % force noise and 20 um displacement noise:
+    the records of ``benchmarks/bench_length.py`` (``kw``: more of :func:`make_case`'s
+    arguments). Returns ``(case, pendulum)``."""
+    p = pendulum(1.30, 0.0553, 0.01)
+    f1 = ref.natural_frequency(p, G) / (2 * np.pi)
+    drive = ref.Ramped(ref.LinearSweep(0.001, 0.6 * f1, 1.6 * f1, duration), 1.5, 0.0)
+    case, _ = make_case(folder, name, drive, pendulums=[p], fixed_mass=1.5, dry_mass=1.2,
+                        noise=0.013, displacement_noise=2e-5, duration=duration, rate=rate,
+                        seed=seed, **kw)
+    return case, p
+
+
 def make_spinning_case(folder: Path, name: str, rig, *, pendulum=None, rotor=None,
                        oscillator=None, fixed_mass=0.0, fixed_height=0.0, noise=0.01,
                        tone=None, drift=0.0, duration=20.0, rate=100.0, seed=0, tank_radius=0.2, fill=0.6,

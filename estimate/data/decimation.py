@@ -192,6 +192,8 @@ def slosh_band_factor(case) -> int | None:
         return None
     n, rate = case.time.size, case.sample_rate
     factor = int(rate / NOTE_RATE_HZ * (1 + 1e-9))  # a 500 Hz record's rate is 499.99..
+    if n < NOTE_SAMPLES or factor < 2:  # before reading the motion's band (every build asks)
+        return None
     band = case.test.motion_band_hz
     if band is None and case.displacement is not None and not case.columns:
         from .signals import motion_band
@@ -203,9 +205,7 @@ def slosh_band_factor(case) -> int | None:
         return None
     if band:  # the carriage motion inside the flat band (nobody asked for this factor)
         factor = min(factor, int(FLAT * rate / band))
-    if n < NOTE_SAMPLES or factor < 2 or n // factor < MIN_SAMPLES:
-        return None
-    return factor
+    return factor if factor >= 2 and n // factor >= MIN_SAMPLES else None
 
 
 #: How many times the memory budget's samples a command that decimates by default reads

@@ -168,18 +168,10 @@ def test_a_case_decimated_twice_is_refused(tmp_path, capsys, again):
 
 
 def _fast_record(tmp_path):
-    """20 s at 500 Hz from rest (10,001 samples): a 1 mm sweep across the 8-inch sphere's
-    first mode, 1.3 % force noise, 20 um displacement noise (the reference simulator)."""
-    import reference_models as ref
-    from synthetic_cases import G, make_case, pendulum
+    """20 s at 500 Hz from rest (10,001 samples): ``synthetic_cases.sweep_record``."""
+    from synthetic_cases import sweep_record
 
-    p = pendulum(1.30, 0.0553, 0.01)
-    f1 = ref.natural_frequency(p, G) / (2 * np.pi)
-    drive = ref.Ramped(ref.LinearSweep(0.001, 0.6 * f1, 1.6 * f1, 20.0), 1.5, 0.0)
-    case, _ = make_case(tmp_path, "F", drive, pendulums=[p], fixed_mass=1.5, dry_mass=1.2,
-                        noise=0.013, displacement_noise=2e-5, duration=20.0, rate=500.0,
-                        seed=21)
-    return case
+    return sweep_record(tmp_path, "F", 20.0, seed=21)[0]
 
 
 def test_slosh_fit_decimates_a_long_fast_record_by_default_and_says_so(tmp_path, capsys):

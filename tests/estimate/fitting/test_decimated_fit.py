@@ -4,8 +4,7 @@ its fit at the full rate (issue 27)."""
 from __future__ import annotations
 
 import numpy as np
-import reference_models as ref
-from synthetic_cases import G, make_case, pendulum
+from synthetic_cases import sweep_record
 
 from estimate import FitProblem, fit, load_case, model_from_spec
 
@@ -17,11 +16,7 @@ def test_a_decimated_fit_keeps_the_estimates_and_their_standard_errors(tmp_path)
     standard error, the robust standard errors by under 3 %, and they stay within 1.21 times
     the Gauss-Newton ones (before the spectral middle read the noise only where the
     anti-alias filter leaves it: 2.6 times, the masses' intervals twice as wide)."""
-    p = pendulum(1.30, 0.0553, 0.01)
-    f1 = ref.natural_frequency(p, G) / (2 * np.pi)
-    drive = ref.Ramped(ref.LinearSweep(0.001, 0.6 * f1, 1.6 * f1, 6.0), 1.5, 0.0)
-    case, _ = make_case(tmp_path, "S", drive, pendulums=[p], fixed_mass=1.5, dry_mass=1.2,
-                        noise=0.013, displacement_noise=2e-5, duration=6.0, rate=500.0, seed=4)
+    case, p = sweep_record(tmp_path, "S", 6.0, seed=4)
     toml = tmp_path / "S.toml"
     (tmp_path / "D.toml").write_text(toml.read_text().replace("[test]\n", "[test]\ndecimate = 5\n"))
     decimated = load_case(tmp_path / "D.toml")
@@ -48,12 +43,7 @@ def test_a_long_fast_record_is_told_how_to_decimate(tmp_path):
     from dataclasses import replace
     from pathlib import Path
 
-    p = pendulum(1.30, 0.0553, 0.01)
-    f1 = ref.natural_frequency(p, G) / (2 * np.pi)
-    drive = ref.Ramped(ref.LinearSweep(0.001, 0.6 * f1, 1.6 * f1, 20.0), 1.5, 0.0)
-    fast, _ = make_case(tmp_path, "F", drive, pendulums=[p], fixed_mass=1.5, dry_mass=1.2,
-                        noise=0.013, displacement_noise=2e-5, duration=20.0, rate=500.0,
-                        seed=5)
+    fast, _ = sweep_record(tmp_path, "F", 20.0, seed=5)
     kept = replace(fast, test=replace(fast.test, decimate=1))
     a1 = load_case(Path(__file__).resolve().parents[3] / "examples" / "A1.toml")
     hint = ("F.csv: 10001 samples at 500 Hz, far above the slosh band: `[test] decimate = 5` "
