@@ -16,7 +16,7 @@ from ._keys import Asked, UnknownKey, unknown_keys
 from ._toml import Checker, read_tables, test_kind
 from .case import Case, CaseError
 from .lab_formats import LAB_SUFFIXES, is_lab_file, read_lab
-from .plausible_units import ImplausibleUnit, unit_warnings
+from .plausible_units import ImplausibleUnit, sampling_problem, unit_warnings
 
 __all__ = ["MAX_CASE_FILE_BYTES", "UnknownKey", "load_case"]
 
@@ -181,19 +181,74 @@ def load_case(path: str | os.PathLike[str], *, strict: bool = False,
     assert arrays is not None and data_path is not None
     assert not (pred_present and prediction is None)
     time, disp, force, columns = arrays
+    if rig_kind != "spinning":
+        slow = sampling_problem(data_path.name, time,
+                                lambda: _first_mode_hz(tank, liquid, rig, prediction))
+        if slow:
+            raise CaseError([slow])
+    acc = None  # a lateral record's carriage acceleration, for the checks below
+    if rig_kind == "lateral" and motion is None and disp is not None:
+        from .signals import displacement_derivatives
+
+        try:
+            acc = displacement_derivatives(time, disp)[2]
+        except Exception:  # noqa: BLE001 - a record the smoother cannot take: not judged
+            acc = None
+    if acc is not None and not is_lab_file(data_path):
+        for line in _csv_unit_warnings(data_path.name, arrays, rig, prediction, acc):
+            warnings.warn(line, ImplausibleUnit, stacklevel=2)
     for arr in (time, disp, force, *columns.values()):
         if arr is not None:
             arr.flags.writeable = False
     case = Case(path=toml_path.resolve(), data_path=data_path.resolve(), test=test, tank=tank,
                 liquid=liquid, rig=rig, prediction=prediction, time=time, displacement=disp,
                 force=force, columns=columns, notes=tuple(n for n in notes if n))
-    if case.motion is not None:
+    if case.motion is not None or acc is not None:
         from .motion_sign import sign_problems
 
-        flipped = sign_problems(case)
+        flipped = sign_problems(case, acceleration=acc)
         if flipped:
             raise CaseError(flipped)
     return case
+
+
+def _first_mode_hz(tank, liquid, rig, prediction) -> float | None:
+    """The tank's first slosh mode [Hz]: ``[prediction]``'s pendulum, else the tank's modal
+    analysis (None when it cannot take the tank)."""
+    import math
+
+    if prediction is not None:
+        return math.sqrt(rig.gravity / prediction.pendulum_length) / (2 * math.pi)
+    from analogs.tank import Liquid, predict
+
+    try:
+        pred = predict(tank.geometry(), fill=tank.fill_fraction, gravity=rig.gravity,
+                       liquid=Liquid(density=liquid.density,
+                                     viscosity=liquid.kinematic_viscosity), modes=1)
+    except Exception:  # noqa: BLE001 - a tank the prediction cannot take: not judged
+        return None
+    return pred.modes[0].frequency_hz if pred.modes else None
+
+
+def _csv_unit_warnings(name: str, arrays: tuple, rig, prediction, acceleration) -> list[str]:
+    """What looks wrong about a lateral CSV record's displacement and force, SI by the
+    format's definition (:func:`estimate.data.plausible_units.unit_warnings`): a column
+    written in mm or a force in lbf or kN. The force is judged against ``[prediction]``'s
+    analog and the container when weighed; without ``[prediction]``, only the displacement
+    (the tank's modal analysis is not solved for a check at every load)."""
+    import math
+
+    time, disp, force, _ = arrays
+    columns = ["displacement"]
+    rigid, modes = rig.dry_mass or 0.0, []
+    if prediction is not None:
+        columns.append("force")
+        rigid += prediction.fixed_mass
+        modes = [(prediction.pendulum_mass, math.sqrt(rig.gravity / prediction.pendulum_length),
+                  prediction.damping_ratio)]
+    return unit_warnings(name, columns, time, disp, force, rigid_mass=rigid, modes=modes,
+                         weighed=rig.dry_mass is not None, csv=True,
+                         acceleration=acceleration)
 
 
 def _unit_warnings(name: str, unitless: dict[str, str], arrays: tuple, tank, liquid, rig

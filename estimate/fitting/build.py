@@ -8,8 +8,11 @@ order.
 from __future__ import annotations
 
 import math
+import warnings
 from collections.abc import Mapping, Sequence
 from dataclasses import dataclass, replace
+
+import numpy as np
 
 from analogs import Model
 from analogs.errors import InputError, UnknownNameError
@@ -313,6 +316,7 @@ def build_problem(cls, cases: Case | Sequence[Case], model: Model, *,
                              force_cutoff_hz=force_cutoff_hz, weights=weights,
                              channel_weights=channel_weights, input=input, lag=lag, start=start)
     cases, hold, w = args.cases, args.hold, args.weights
+    w, clip_notes = _without_bad_samples(cases, w)
     model = model.validate()
     exps = experiments(cases, model)
     measurement = _resolve_channels(tuple(measurement), exps)
@@ -328,6 +332,7 @@ def build_problem(cls, cases: Case | Sequence[Case], model: Model, *,
     params = model_parameters(exps, measurement)
     raise_all(name_problems(args, estimate, params, exps, measurement))
     notes = [n for c in cases for n in c.notes]  # what loading did to the records
+    notes += clip_notes
     notes += [n for c in cases if (n := decimation_note(c))]
     six_axis = any(c.motion is not None for c in cases)
     if six_axis:
@@ -368,6 +373,25 @@ def build_problem(cls, cases: Case | Sequence[Case], model: Model, *,
                args.channel_weights, args.mode, carriage, noise, ties, linear, stage, inside,
                prediction_start={e.name: st.before_stage[e.parameter] for e in est
                                  if e.parameter in st.before_stage})
+
+
+def _without_bad_samples(cases: Sequence[Case], weights: tuple) -> tuple[tuple, list[str]]:
+    """The sample weights with every clipped sample's and spike's set to 0
+    (:func:`estimate.data.bad_samples.bad_samples`) and a warning per flagged channel (also
+    returned as the fit's notes)."""
+    from ..data.bad_samples import BadSamples, bad_samples
+
+    out, notes = list(weights), []
+    for i, case in enumerate(cases):
+        mask, found = bad_samples(case)
+        if mask is None:
+            continue
+        base = np.ones(case.time.size) if out[i] is None else np.asarray(out[i], float)
+        out[i] = np.where(mask, 0.0, base)
+        for f in found:
+            notes.append(f.describe(case.test.id))
+            warnings.warn(notes[-1], BadSamples, stacklevel=3)
+    return tuple(out), notes
 
 
 def _resolve_channels(measurement: tuple, exps: Sequence[Experiment]) -> tuple:

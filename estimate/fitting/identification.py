@@ -249,6 +249,8 @@ def identify(records, *, frequency_hz: float, gravity: float | None = None,
     if all(not np.any(np.abs(r.acceleration(r.time)) > 0) for r in recs):
         return None
     top_hz = min(0.25 * fs, 0.5 * cutoff)
+    if not top_hz > min_hz:  # sampled too slowly for any mode searched
+        return None
     profiled = _frequency_profile(recs, max(lo, min_hz), min(hi, top_hz))
     if profiled is not None and all(abs(profiled / s - 1) > SPREAD_RELATIVE for s in starts):
         starts.append(profiled)
