@@ -105,7 +105,8 @@ def _held_out_text() -> str:
 
 def _fitted_on(res: FitResult) -> str:
     """What a fit of the diagnosis was fitted on, for a heading."""
-    if not res.weights or all(np.all(w > 0) for w in res.weights):
+    if not res.weights or not any(res.problem.held_out(i, w).any()
+                                  for i, w in enumerate(res.weights)):
         return "every sample"
     kept = HOLDOUT_BLOCKS - len(HELD_OUT_BLOCKS)
     return (f"{kept} of {HOLDOUT_BLOCKS} interleaved blocks; the other {len(HELD_OUT_BLOCKS)} "
@@ -243,7 +244,8 @@ def before_after_figure(d: Diagnosis, path: str | Path | None = None):
                    for r in (d.baseline, d.final))
     # the baseline's simulation in its held-out blocks follows a carriage motion read off
     # the displacement alone: shaded and left blank, as in its residual panel
-    held_base = (d.baseline.weights[0] == 0) if d.baseline.weights else np.zeros(t.size, bool)
+    held_base = d.baseline.problem.held_out(0, d.baseline.weights[0] if d.baseline.weights
+                                            else None)
     base = np.where(held_base, np.nan, base)
     fig = style.figure(path, figsize=(10, 8.5))
     ax = fig.subplots(3, 1, sharex=True, height_ratios=[2.2, 1, 1])
@@ -283,9 +285,11 @@ def before_after_figure(d: Diagnosis, path: str | Path | None = None):
     for a, res, name in ((ax[1], d.baseline, "baseline"), (ax[2], d.final, "final")):
         # the held-out blocks are no residual of the fitted model: the carriage motion there
         # rests on the displacement alone, so they are shaded and left blank
-        held = (res.weights[0] == 0) if res.weights else np.zeros(t.size, bool)
+        held = res.problem.held_out(0, res.weights[0] if res.weights else None)
         resid = shown.column(res.residuals[0])
-        r = np.where(held, np.nan, resid)
+        left = res.problem.left_out[0] if res.problem.left_out else None
+        # clipped samples and spikes are no residual either: left blank, unshaded
+        r = np.where(held if left is None else held | left, np.nan, resid)
         a.axhspan(-noise, noise, color="#4393c3", alpha=0.2, lw=0,
                   label=f"noise RMS +/-{noise:.3g} {unit}")
         a.plot(t, r, **style.RESIDUAL, label=f"{name} residual")
@@ -326,14 +330,16 @@ def residual_spectra_figure(d: Diagnosis, path: str | Path | None = None):
     # the baseline's residual on its fitted samples only (held-out blocks zeroed, the
     # density scaled back by the fitted share): the held-out blocks are no residual of it
     w = d.baseline.weights[0] > 0 if d.baseline.weights else np.ones(t.size, bool)
+    # the final fit's left-out samples (clipped, spikes) likewise; it holds nothing out
+    w_final = d.final.weights[0] > 0 if d.final.weights else np.ones(t.size, bool)
     for y, share, label, kw in (
             (shown.column(d.baseline.measured[0]), 1.0, _measured_label(d.baseline, shown),
              {"color": "0.75", "lw": 1.0}),
             (np.where(w, shown.column(d.baseline.residuals[0]), 0.0), float(np.mean(w)),
              f"baseline residual ({_model_text(d.baseline)}), fitted samples",
              {"color": "#e08214", "lw": 2.4, "alpha": 0.7}),
-            (shown.column(d.final.residuals[0]), 1.0, f"final residual ({_model_text(d.final)})",
-             {"color": "0.1", "lw": 0.9})):
+            (np.where(w_final, shown.column(d.final.residuals[0]), 0.0), float(np.mean(w_final)),
+             f"final residual ({_model_text(d.final)})", {"color": "0.1", "lw": 0.9})):
         sp = welch_spectrum(t, y)
         band = (sp.frequency <= top_f)
         ax.semilogy(sp.frequency[band], np.sqrt(sp.psd[band] / share), label=label, **kw)

@@ -157,7 +157,7 @@ def heldout(res: FitResult) -> tuple[float, float]:
     num = chi2 = 0.0
     cnt = 0
     for i, w in enumerate(res.weights):
-        out = w == 0
+        out = res.problem.held_out(i, w)
         if not np.any(out):
             continue
         chans = res.channels[i] if res.channels else ("force_x",)

@@ -316,7 +316,7 @@ def build_problem(cls, cases: Case | Sequence[Case], model: Model, *,
                              force_cutoff_hz=force_cutoff_hz, weights=weights,
                              channel_weights=channel_weights, input=input, lag=lag, start=start)
     cases, hold, w = args.cases, args.hold, args.weights
-    w, clip_notes = _without_bad_samples(cases, w)
+    w, left_out, clip_notes = _without_bad_samples(cases, w)
     model = model.validate()
     exps = experiments(cases, model)
     measurement = _resolve_channels(tuple(measurement), exps)
@@ -372,18 +372,21 @@ def build_problem(cls, cases: Case | Sequence[Case], model: Model, *,
     return cls(model, exps, tuple(est), tuple(fixed), tuple(notes), w, tuple(measurement),
                args.channel_weights, args.mode, carriage, noise, ties, linear, stage, inside,
                prediction_start={e.name: st.before_stage[e.parameter] for e in est
-                                 if e.parameter in st.before_stage})
+                                 if e.parameter in st.before_stage},
+               left_out=left_out if any(m is not None for m in left_out) else ())
 
 
-def _without_bad_samples(cases: Sequence[Case], weights: tuple) -> tuple[tuple, list[str]]:
+def _without_bad_samples(cases: Sequence[Case], weights: tuple
+                         ) -> tuple[tuple, tuple, list[str]]:
     """The sample weights with every clipped sample's and spike's set to 0
-    (:func:`estimate.data.bad_samples.bad_samples`) and a warning per flagged channel (also
-    returned as the fit's notes)."""
+    (:func:`estimate.data.bad_samples.bad_samples`), those samples per case (or None), and
+    a warning per flagged channel (also returned as the fit's notes)."""
     from ..data.bad_samples import BadSamples, bad_samples
 
-    out, notes = list(weights), []
+    out, masks, notes = list(weights), [], []
     for i, case in enumerate(cases):
         mask, found = bad_samples(case)
+        masks.append(mask)
         if mask is None:
             continue
         base = np.ones(case.time.size) if out[i] is None else np.asarray(out[i], float)
@@ -391,7 +394,7 @@ def _without_bad_samples(cases: Sequence[Case], weights: tuple) -> tuple[tuple, 
         for f in found:
             notes.append(f.describe(case.test.id))
             warnings.warn(notes[-1], BadSamples, stacklevel=3)
-    return tuple(out), notes
+    return tuple(out), tuple(masks), notes
 
 
 def _resolve_channels(measurement: tuple, exps: Sequence[Experiment]) -> tuple:

@@ -94,8 +94,12 @@ def _time_panel(ax, t, meas, sim, unit: str, name: str, *, zooms: bool,
     ax.legend(loc="lower left", bbox_to_anchor=(0, 1.0), ncols=2, fontsize="small", frameon=False)
 
 
-def _residual_panel(ax, t, items, unit: str, keep: np.ndarray | None) -> None:
-    """``items``: (name, residual). Symmetric axis from the residual after the start-up."""
+def _residual_panel(ax, t, items, unit: str, keep: np.ndarray | None,
+                    left: np.ndarray | None = None) -> None:
+    """``items``: (name, residual). Symmetric axis from the residual after the start-up;
+    ``left``: samples left out of the fit (clipped, spikes), not drawn."""
+    if left is not None:
+        items = [(n, np.where(left, np.nan, r)) for n, r in items]
     end = style.startup_end(t)
     steady = t > end
     if keep is not None:
@@ -105,9 +109,9 @@ def _residual_panel(ax, t, items, unit: str, keep: np.ndarray | None) -> None:
         kw = dict(style.RESIDUAL) if len(items) == 1 else {"lw": 0.7, "color": f"C{i}"}
         ax.plot(t, r, label=f"residual {name}" if len(items) > 1 else "residual (simulated - measured)",
                 **kw)
-    all_r = np.max(np.abs(np.vstack([r for _, r in items])), axis=0)
+    all_r = np.nan_to_num(np.max(np.abs(np.vstack([r for _, r in items])), axis=0))
     style.mark_startup(ax, t, all_r, end, limit, unit)
-    rms = [float(np.sqrt(np.mean(r[steady] ** 2))) for _, r in items]
+    rms = [float(np.sqrt(np.nanmean(r[steady] ** 2))) for _, r in items]
     ax.axhline(0.0, color="0.6", lw=0.5, zorder=1)
     ax.set(ylabel=f"residual [{unit}]", xlabel="time [s]", ylim=(-limit, limit), xlim=(t[0], t[-1]))
     ax.set_title(f"residual after the start-up: RMS {max(rms):.3g} {unit}", fontsize="medium", loc="left")
@@ -130,10 +134,14 @@ def _spectrum_panel(ax, result, case, t, items, unit: str, drive: float | None,
                     **({**style.MEASURED, "lw": 1.8} if len(items) == 1 else {"lw": 1.6, "alpha": 0.35,
                                                                                "color": f"C{i}"}))
         curves.append(np.sqrt(sp.psd[band & (sp.frequency > 0)]))
-        sp = welch_spectrum(t, res)
-        ax.semilogy(sp.frequency[band], np.sqrt(sp.psd[band]), label=f"residual{band_label}",
+        # samples left out of the fit (clipped, spikes) are no residual: zeroed, the density
+        # scaled back by the share kept
+        left = result.problem.left_out[case] if result.problem.left_out else None
+        share = 1.0 if left is None else max(float(np.mean(~left)), 1e-9)
+        sp = welch_spectrum(t, res if left is None else np.where(left, 0.0, res))
+        ax.semilogy(sp.frequency[band], np.sqrt(sp.psd[band] / share), label=f"residual{band_label}",
                     **(style.RESIDUAL if len(items) == 1 else {"lw": 0.8, "color": f"C{i}"}))
-        curves.append(np.sqrt(sp.psd[band & (sp.frequency > 0)]))
+        curves.append(np.sqrt(sp.psd[band & (sp.frequency > 0)] / share))
         floor = noise_density(result, name, case)
         if floor is not None:
             floors.append(floor)
@@ -238,7 +246,8 @@ def plot_fit(result: "FitResult", path: str | Path | None = None, *, case: int =
     ax[len(channels) - 1].set_xlabel("time [s]")
     k = len(channels)
     for a, (unit, items) in zip(ax[k:], groups.items()):
-        _residual_panel(a, t, [(n, r) for n, _, r in items], unit, keep)
+        _residual_panel(a, t, [(n, r) for n, _, r in items], unit, keep,
+                        result.problem.left_out[case] if result.problem.left_out else None)
     k += len(groups)
     drive = drive_frequency_of(result, case)
     modes = mode_frequencies(result)

@@ -102,6 +102,28 @@ class FitProblem:
     #: The starts the first stage replaced, as the prediction gave them (by label): a second
     #: start when the first stage's masses are far from them (:func:`~estimate.fitting.nlp.fit`).
     prediction_start: Mapping[str, float] = field(default_factory=dict, repr=False)
+    #: Per case, the samples left out because they are no measurements (clipped, spikes:
+    #: :mod:`estimate.data.bad_samples`; weight 0), as opposed to held out (``None``: none).
+    left_out: tuple[np.ndarray | None, ...] = field(default=(), repr=False)
+
+    def held_out(self, case: int, weights: np.ndarray | None = None) -> np.ndarray:
+        """The samples of case ``case`` with weight 0 (in ``weights``, default the
+        problem's) that were not :attr:`left_out`: held out of the cost (a diagnosis's
+        blocks, a six-axis record's filter ends)."""
+        n = self.experiments[case].case.time.size
+        if weights is None and self.weights:
+            weights = self.weights[case]
+        held = np.zeros(n, bool) if weights is None else np.asarray(weights) == 0
+        bad = self.left_out[case] if self.left_out else None
+        if bad is None:
+            return held
+        out = held & ~bad
+        # a left-out run inside a held-out block (held samples on both sides) is the block's
+        edges = np.diff(np.r_[0, (bad & held).astype(np.int8), 0])
+        for s, e in zip(np.flatnonzero(edges == 1), np.flatnonzero(edges == -1)):
+            if s > 0 and e < n and out[s - 1] and out[e]:
+                out[s:e] = True
+        return out
 
     @classmethod
     def build(cls, cases: Case | Sequence[Case], model: Model, *,

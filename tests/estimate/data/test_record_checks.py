@@ -158,3 +158,25 @@ def test_records_as_rigs_write_them_flag_nothing():
                                              decay=6.0, seed=3).case)
         found = {c.test.id: bad_samples(c)[1] for c in cases}
     assert all(not f for f in found.values()), found
+
+
+def test_a_clipped_record_is_diagnosed_on_its_measurements(tmp_path):
+    # the diagnosis scores candidates on held-out blocks (weight 0 in its fits): the
+    # clipped samples, weight 0 as well, must not count as held out (their residual is the
+    # clipping's, 30 times the noise), nor be drawn as residuals
+    from estimate.diagnosis import diagnose
+
+    d = DATA.copy()
+    d[:, 2] = np.clip(d[:, 2], -6.0, 6.0)
+    case = load_case(_a1(tmp_path, "clip", d))
+    with warnings.catch_warnings():
+        warnings.simplefilter("ignore", BadSamples)
+        dg = diagnose(case)
+    assert dg.findings == ()
+    left = dg.baseline.problem.left_out[0]
+    held = dg.baseline.problem.held_out(0, dg.baseline.weights[0])
+    assert left.sum() == 967 and not (held & ~(dg.baseline.weights[0] == 0)).any()
+    # three held-out blocks of 3 s, whole: the clipped runs inside them belong to them
+    edges = np.flatnonzero(np.diff(np.r_[0, held.astype(int), 0]))
+    assert len(edges) == 6 and all(b - a > 290 for a, b in zip(edges[::2], edges[1::2]))
+    assert dg.final.rms_residual < 1.05 * 0.0712

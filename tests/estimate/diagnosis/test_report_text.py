@@ -62,12 +62,29 @@ def test_a_trend_says_which_way_and_by_how_much():
     assert "rises" in _trend("frequency", (2.0, 2.03), SIGNIFICANT_T, 1.0).text()
 
 
+def _fit(weights, left_out=None):
+    """A fit result as far as `_fitted_on` reads it: its weights and its problem's held-out
+    samples (weight 0, not left out as clipped or spikes)."""
+    from estimate.fitting.problem import FitProblem
+
+    n = 3001 if weights is None else weights[0].size
+    case = SimpleNamespace(time=np.zeros(n))
+    problem = SimpleNamespace(experiments=(SimpleNamespace(case=case),), weights=weights,
+                              left_out=() if left_out is None else (left_out,))
+    problem.held_out = lambda i, w=None: FitProblem.held_out(problem, i, w)
+    return SimpleNamespace(weights=weights, problem=problem)
+
+
 def test_the_parameter_tables_say_what_each_fit_was_fitted_on():
     n = 3001
-    baseline = SimpleNamespace(weights=(holdout_weights(n),))
+    baseline = _fit((holdout_weights(n),))
     assert int(np.sum(baseline.weights[0] == 0)) == pytest.approx(
         n * len(HELD_OUT_BLOCKS) / HOLDOUT_BLOCKS, abs=len(HELD_OUT_BLOCKS))
     assert _fitted_on(baseline) == ("7 of 10 interleaved blocks; the other 3 held out to score "
                                     "the candidates")
-    assert _fitted_on(SimpleNamespace(weights=None)) == "every sample"
-    assert _fitted_on(SimpleNamespace(weights=(np.ones(n),))) == "every sample"
+    assert _fitted_on(_fit(None)) == "every sample"
+    assert _fitted_on(_fit((np.ones(n),))) == "every sample"
+    # samples left out as clipped or spikes hold nothing out
+    clipped = np.zeros(n, bool)
+    clipped[100:140] = True
+    assert _fitted_on(_fit((np.where(clipped, 0.0, 1.0),), clipped)) == "every sample"
