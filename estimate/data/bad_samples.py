@@ -56,13 +56,17 @@ class Flagged:
     mask: NDArray[np.bool_]
     detail: str
 
-    def describe(self, name: str) -> str:
-        """One line for the fit's notes and warnings (``name``: the case's id)."""
+    def summary(self) -> str:
+        """What was found: ``"967 samples (32 %) read exactly -6 and +6, ...: clipped
+        (...)"``."""
         n, count = self.mask.size, int(self.mask.sum())
         what = ("clipped (the transducer or the acquisition saturated)" if self.kind == "clipped"
                 else "spikes (far off both their neighbours: glitches, not force)")
-        return (f"{name}: column `{self.channel}`: {count} sample{'s' * (count != 1)} "
-                f"({100 * count / n:.2g} %) {self.detail}: {what}; left out of the fit")
+        return f"{count} sample{'s' * (count != 1)} ({100 * count / n:.2g} %) {self.detail}: {what}"
+
+    def describe(self, name: str) -> str:
+        """One line for the fit's notes and warnings (``name``: the case's id)."""
+        return f"{name}: column `{self.channel}`: {self.summary()}; left out of the fit"
 
 
 def _runs(mask: NDArray[np.bool_]) -> tuple[NDArray[np.intp], NDArray[np.intp]]:
@@ -71,9 +75,12 @@ def _runs(mask: NDArray[np.bool_]) -> tuple[NDArray[np.intp], NDArray[np.intp]]:
     return np.flatnonzero(edges == 1), np.flatnonzero(edges == -1)
 
 
-def clipping(channel: str, values: NDArray[np.float64]) -> Flagged | None:
+def clipping(channel: str, values: NDArray[np.float64], *, min_runs: int = 1
+             ) -> Flagged | None:
     """The clipped samples of one channel (see :data:`MIN_CLIPPED_FRACTION` and
-    :data:`MIN_CLIPPED_RUN`), or None.
+    :data:`MIN_CLIPPED_RUN`), or None. ``min_runs``: fewest separate runs of
+    :data:`MIN_CLIPPED_RUN` or more at a level (a carriage displacement holds its end
+    position once, legitimately; clipped, it flattens every peak).
 
     Examples
     --------
@@ -96,7 +103,8 @@ def clipping(channel: str, values: NDArray[np.float64]) -> Flagged | None:
         at = x == level
         starts, ends = _runs(at)
         run = int((ends - starts).max()) if starts.size else 0
-        if at.sum() >= need and run >= MIN_CLIPPED_RUN:
+        long_runs = int(np.sum(ends - starts >= MIN_CLIPPED_RUN))
+        if at.sum() >= need and run >= MIN_CLIPPED_RUN and long_runs >= min_runs:
             mask |= at
             levels.append(level)
             longest = max(longest, run)

@@ -103,6 +103,29 @@ def test_csv_columns_in_other_units_are_named(tmp_path):
     assert _loaded(EXAMPLES / "A1.toml")[1] == []
 
 
+def test_a_clipped_displacement_is_refused(tmp_path):
+    # an LVDT channel saturating at 80 % of the stroke (40 % of the samples): fitted, the
+    # fixed mass went to its bound 0 and the slosh mass to 1.76 kg, its interval
+    # [1.47, 1.97] excluding the truth 1.30, "converged"
+    d = DATA.copy()
+    lim = 0.8 * np.abs(d[:, 1]).max()
+    d[:, 1] = np.clip(d[:, 1], -lim, lim)
+    found = _problems(_a1(tmp_path, "dclip", d))
+    assert len(found) == 1 and found[0].startswith("dclip.csv: column `displacement`: 1205 "
+                                                   "samples (40 %) read exactly")
+    assert "the carriage motion is unknown where it is clipped" in found[0]
+
+
+def test_a_quantised_displacement_is_no_clipped_one(tmp_path):
+    # an encoder of 5 um steps: every peak of a steady sine reads the same top step for a
+    # few samples; and a force quantised to 5 mN
+    d = DATA.copy()
+    d[:, 1] = np.round(d[:, 1] / 5e-6) * 5e-6
+    d[:, 2] = np.round(d[:, 2] / 5e-3) * 5e-3
+    case, _ = _loaded(_a1(tmp_path, "quantised", d))
+    assert bad_samples(case)[1] == []
+
+
 def _fit(path: Path):
     case = load_case(path)
     with warnings.catch_warnings(record=True) as caught:
