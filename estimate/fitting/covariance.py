@@ -116,16 +116,26 @@ def uncertainty(jac_residuals: sps.spmatrix, jac_constraints: sps.spmatrix,
     nw, ng = Je.shape[1], Jg.shape[0]
     k = nw - ng  # estimated quantities: variables the constraints leave free
     sigma2 = float(residuals @ residuals) / max(n_observations - k, 1)
-    if not (np.isfinite(Je.data).all() and np.isfinite(Jg.data).all() and np.isfinite(sigma2)):
-        # a fit that diverged (IPOPT's Invalid_Number_Detected: a 60 s spinning-rig record
-        # whose simulation overflowed) ends where its sensitivities are not numbers
+    def undetermined(why: str) -> Uncertainty:
         nan = np.full((ntheta, ntheta), np.nan)
         return Uncertainty(nan, np.full(ntheta, np.nan), nan.copy(), sigma2,
                            Identifiability(np.zeros(0), float("inf"), (), ()),
-                           ("the fit ended where the model's sensitivities are not finite (it "
-                            "diverged): no covariance",), np.full(ntheta, np.nan))
-    kkt = ReducedKKT(Je, Jg, ntheta)
+                           (f"the fit ended where {why} (it diverged): no covariance",),
+                           np.full(ntheta, np.nan))
+
+    if not (np.isfinite(Je.data).all() and np.isfinite(Jg.data).all() and np.isfinite(sigma2)):
+        # a fit that diverged (IPOPT's Invalid_Number_Detected: a 60 s spinning-rig record
+        # whose simulation overflowed) ends where its sensitivities are not numbers
+        return undetermined("the model's sensitivities are not finite")
+    try:
+        kkt = ReducedKKT(Je, Jg, ntheta)
+    except (RuntimeError, np.linalg.LinAlgError):
+        # SuperLU's "Factor is exactly singular": the states' KKT block at a point where
+        # the fit was last finite (a spinning-rig rotor fit whose simulation overflowed)
+        return undetermined("the states' KKT block is singular")
     S = kkt.information
+    if not np.all(np.isfinite(S)):
+        return undetermined("the parameters' information is not finite")
     free = np.setdiff1d(np.arange(ntheta), np.asarray(held, int))
     # a prior of relative standard deviation 1e3 on every (scaled) parameter: nothing for
     # what the data determine, a huge finite variance for a direction they do not
@@ -309,6 +319,11 @@ class ReducedKKT:
             self.Y = self._solve(self.B)
         S = self.Htt - self.B.T @ self.Y
         self.information = 0.5 * (S + S.T)
+        if not np.all(np.isfinite(self.information)):
+            # overflowed (a point where the fit was last finite): :func:`uncertainty` says
+            # so; eigh would raise
+            self.singular, self.inverse_information = True, np.full_like(S, np.nan)
+            return
         lam, V = np.linalg.eigh(self.information)
         self.singular = bool(lam.min() <= _PRIOR_INFORMATION * max(lam.max(), 1.0) * 1e-3)
         self.inverse_information = (V / np.maximum(lam, _PRIOR_INFORMATION)) @ V.T

@@ -277,10 +277,6 @@ def _solve(problem: FitProblem, transcription: Transcription, hessian: Hessian, 
     opts["ipopt.mumps_pivot_order"] = pivot_order(problem)
     derivatives, f, g_once = nlp.derivative_options(hessian, blocks_ok)
     opts.update(derivatives)
-    recorder = Recorder(nlp.w.numel(), nlp.g.numel(), len(est), scales, 2 * nlp.norm,
-                         progress_printer(problem.names) if progress else None,
-                         stall_stop(problem, int(nlp.r.numel())))
-    opts["iteration_callback"] = recorder
     g = nlp.g
     if "jac_g" in opts:
         # IPOPT gets g and its Jacobian from the per-interval functions (compiled when a
@@ -289,13 +285,35 @@ def _solve(problem: FitProblem, transcription: Transcription, hessian: Hessian, 
         g = nlp.g_fast if g_once is None else g_once
         opts.update({"no_nlp_grad": True, "calc_lam_p": False})
     opts.update(dict(solver_options or {}))
-    solver = ca.nlpsol("fit", "ipopt", {"x": nlp.w, "f": f, "g": g}, opts)
     lbx, ubx = nlp.bounds(est)
     lbg, ubg = nlp.constraint_bounds()
-    with surfacing():  # an interrupt inside IPOPT is an interruption, not a non-convergence
-        sol = solver(x0=nlp.w0, lbx=lbx, ubx=ubx, lbg=lbg, ubg=ubg)
-    if progress:
-        print(file=sys.stderr)
+
+    def run(options: dict):
+        recorder = Recorder(nlp.w.numel(), nlp.g.numel(), len(est), scales, 2 * nlp.norm,
+                            progress_printer(problem.names) if progress else None,
+                            stall_stop(problem, int(nlp.r.numel())))
+        solver = ca.nlpsol("fit", "ipopt", {"x": nlp.w, "f": f, "g": g},
+                           {**options, "iteration_callback": recorder})
+        with surfacing():  # an interrupt inside IPOPT is an interruption, not a non-convergence
+            sol = solver(x0=nlp.w0, lbx=lbx, ubx=ubx, lbg=lbg, ubg=ubg)
+        if progress:
+            print(file=sys.stderr)
+        return solver, sol, recorder
+
+    solver, sol, recorder = run(opts)
+    retry_note = None
+    if (solver.stats().get("return_status") == "Invalid_Number_Detected"
+            and "ipopt.bound_mult_init_val" not in (solver_options or {})):
+        # the simulation overflowed at an iterate: IPOPT's own bound multipliers (1), whose
+        # curvature keeps the first steps short, from the same start (a 20 s spinning-rig
+        # rotor fit: NaN from iteration 3 with 1e-5, converged in 27 iterations with 1)
+        first_iterations = int(solver.stats().get("iter_count", 0))
+        again = run({**opts, "ipopt.bound_mult_init_val": 1.0})
+        if again[0].stats().get("success", False):
+            solver, sol, recorder = again
+            retry_note = (f"the fit's first solve overflowed (Invalid_Number_Detected after "
+                          f"{first_iterations} iterations): solved again with IPOPT's "
+                          "default bound multipliers, which keep the first steps short")
     w_opt = np.asarray(sol["x"]).ravel()
     # IPOPT may leave a bounded variable a hair outside its bound (its bound_relax_factor)
     theta = np.clip(w_opt[: len(est)] * scales, [e.lower for e in est], [e.upper for e in est])
@@ -320,6 +338,8 @@ def _solve(problem: FitProblem, transcription: Transcription, hessian: Hessian, 
     stats = solver.stats()
     if recorder.stopped:  # the cost stalled (not an interrupt: `surfacing` raises those)
         stats = {**stats, "return_status": STALLED, "success": False}
+    if retry_note is not None:
+        problem = replace(problem, notes=problem.notes + (retry_note,))
     return fit_result(problem, Solve(theta, stats, recorder, tuple(terms), out, J, Je,
                                      Jg, t_start, transcription, cost, tuple(kinds),
                                      initial_states))
