@@ -301,19 +301,6 @@ def _solve(problem: FitProblem, transcription: Transcription, hessian: Hessian, 
         return solver, sol, recorder
 
     solver, sol, recorder = run(opts)
-    retry_note = None
-    if (solver.stats().get("return_status") == "Invalid_Number_Detected"
-            and "ipopt.bound_mult_init_val" not in (solver_options or {})):
-        # the simulation overflowed at an iterate: IPOPT's own bound multipliers (1), whose
-        # curvature keeps the first steps short, from the same start (a 20 s spinning-rig
-        # rotor fit: NaN from iteration 3 with 1e-5, converged in 27 iterations with 1)
-        first_iterations = int(solver.stats().get("iter_count", 0))
-        again = run({**opts, "ipopt.bound_mult_init_val": 1.0})
-        if again[0].stats().get("success", False):
-            solver, sol, recorder = again
-            retry_note = (f"the fit's first solve overflowed (Invalid_Number_Detected after "
-                          f"{first_iterations} iterations): solved again with IPOPT's "
-                          "default bound multipliers, which keep the first steps short")
     w_opt = np.asarray(sol["x"]).ravel()
     # IPOPT may leave a bounded variable a hair outside its bound (its bound_relax_factor)
     theta = np.clip(w_opt[: len(est)] * scales, [e.lower for e in est], [e.upper for e in est])
@@ -338,8 +325,6 @@ def _solve(problem: FitProblem, transcription: Transcription, hessian: Hessian, 
     stats = solver.stats()
     if recorder.stopped:  # the cost stalled (not an interrupt: `surfacing` raises those)
         stats = {**stats, "return_status": STALLED, "success": False}
-    if retry_note is not None:
-        problem = replace(problem, notes=problem.notes + (retry_note,))
     return fit_result(problem, Solve(theta, stats, recorder, tuple(terms), out, J, Je,
                                      Jg, t_start, transcription, cost, tuple(kinds),
                                      initial_states))
