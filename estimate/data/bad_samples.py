@@ -14,6 +14,7 @@ that the fit leaves them out (weight 0):
 
 from __future__ import annotations
 
+import weakref
 from dataclasses import dataclass
 
 import numpy as np
@@ -22,7 +23,7 @@ from numpy.typing import NDArray
 from .case import Case
 
 __all__ = ["MIN_CLIPPED_FRACTION", "MIN_CLIPPED_RUN", "SPIKE_FACTOR", "BadSamples",
-           "Flagged", "bad_samples", "clipping", "spikes"]
+           "Flagged", "bad_samples", "clipping", "runs", "spikes"]
 
 #: A channel is clipped at an extreme value when at least this share of its samples (and
 #: at least :data:`_MIN_CLIPPED_SAMPLES`) read exactly that value...
@@ -69,7 +70,7 @@ class Flagged:
         return f"{name}: column `{self.channel}`: {self.summary()}; left out of the fit"
 
 
-def _runs(mask: NDArray[np.bool_]) -> tuple[NDArray[np.intp], NDArray[np.intp]]:
+def runs(mask: NDArray[np.bool_]) -> tuple[NDArray[np.intp], NDArray[np.intp]]:
     """Starts and (exclusive) ends of the runs of True in ``mask``."""
     edges = np.diff(np.r_[0, mask.astype(np.int8), 0])
     return np.flatnonzero(edges == 1), np.flatnonzero(edges == -1)
@@ -101,7 +102,7 @@ def clipping(channel: str, values: NDArray[np.float64], *, min_runs: int = 1
     levels, longest = [], 0
     for level in (float(x.min()), float(x.max())):
         at = x == level
-        starts, ends = _runs(at)
+        starts, ends = runs(at)
         run = int((ends - starts).max()) if starts.size else 0
         long_runs = int(np.sum(ends - starts >= MIN_CLIPPED_RUN))
         if at.sum() >= need and run >= MIN_CLIPPED_RUN and long_runs >= min_runs:
@@ -160,7 +161,7 @@ def spikes(channel: str, values: NDArray[np.float64],
                 if outer.size and abs(x[j] - np.median(outer)) > SPIKE_FACTOR * scale and \
                         np.sign(x[j] - np.median(outer)) == np.sign(off[i]):
                     mask[j] = True
-    starts, ends = _runs(mask)
+    starts, ends = runs(mask)
     for s, e in zip(starts, ends):
         if e - s > _SPIKE_RUN:
             mask[s:e] = False
@@ -172,10 +173,25 @@ def spikes(channel: str, values: NDArray[np.float64],
                    f"stand off both neighbours by up to {abs(off[k]):.3g} N{where}")
 
 
+#: What :func:`bad_samples` found in live cases: ``id(case) -> (weak reference, result)``
+#: (every problem built of a case asks; a diagnosis builds dozens).
+_FOUND: dict[int, tuple[weakref.ref, tuple]] = {}
+
+
 def bad_samples(case: Case) -> tuple[NDArray[np.bool_] | None, list[Flagged]]:
     """The samples of ``case`` flagged in any measured force channel (True; None when none
     is) and each flagged channel's :class:`Flagged` (clipped first, then spikes among the
-    samples that are not clipped)."""
+    samples that are not clipped), found once per case (a case is immutable)."""
+    key = id(case)
+    entry = _FOUND.get(key)
+    if entry is None or entry[0]() is not case:
+        entry = (weakref.ref(case, lambda _: _FOUND.pop(key, None)), _find(case))
+        _FOUND[key] = entry
+    mask, found = entry[1]
+    return mask, list(found)
+
+
+def _find(case: Case) -> tuple[NDArray[np.bool_] | None, tuple[Flagged, ...]]:
     channels = {}
     if case.force is not None:
         channels["force"] = case.force
@@ -195,8 +211,8 @@ def bad_samples(case: Case) -> tuple[NDArray[np.bool_] | None, list[Flagged]]:
         if spike is not None:
             found.append(spike)
     if not found:
-        return None, []
+        return None, ()
     mask = np.zeros(case.time.size, bool)
     for f in found:
         mask |= f.mask
-    return mask, found
+    return mask, tuple(found)

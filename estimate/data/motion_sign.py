@@ -162,21 +162,19 @@ def _reversed_mass(t: np.ndarray, F: np.ndarray, s: np.ndarray, frequency_hz: fl
     step = max(int(1.0 / (4.0 * cutoff * dt)), 1)  # four samples per cutoff period
     tk, Fl, sl = t[::step], Fl[::step], sl[::step]
     ds = sl - sl[0]
-    grid = [(f, zeta) for f in f0 * np.geomspace(*_SIGN_BAND, _SIGN_GRID) for zeta in _SIGN_ZETAS]
-    nums, dens = mode_filters(np.array([g[0] for g in grid]), np.array([g[1] for g in grid]),
-                              1.0 / (step * dt))
-    B = np.empty((len(grid), tk.size))
-    for k in range(len(grid)):
-        B[k] = signal.lfilter(nums[k], dens[k], ds)
+    freqs, zetas = (g.ravel() for g in np.meshgrid(f0 * np.geomspace(*_SIGN_BAND, _SIGN_GRID),
+                                                   _SIGN_ZETAS, indexing="ij"))
+    nums, dens = mode_filters(freqs, zetas, 1.0 / (step * dt))
+    B = np.array([signal.lfilter(b, a, ds) for b, a in zip(nums, dens)])
     # every grid point's least squares at once: its normal equations, the fixed columns
     # [ds, 1, t] shared and the mode's column b varying (column-scaled: t is tens of s)
     fixed = np.column_stack([ds, np.ones_like(tk), tk - tk[0]])
     order = [0, 3, 1, 2]  # the columns as X orders them: ds, b, 1, t
-    G = np.empty((len(grid), 4, 4))
+    G = np.empty((freqs.size, 4, 4))
     G[:, :3, :3] = fixed.T @ fixed
     cross = B @ fixed
     G[:, 3, :3], G[:, :3, 3], G[:, 3, 3] = cross, cross, np.einsum("ij,ij->i", B, B)
-    h = np.empty((len(grid), 4))
+    h = np.empty((freqs.size, 4))
     h[:, :3], h[:, 3] = fixed.T @ Fl, B @ Fl
     G, h = G[:, order][:, :, order], h[:, order]
     scale = np.sqrt(np.einsum("kii->ki", G))
@@ -184,13 +182,11 @@ def _reversed_mass(t: np.ndarray, F: np.ndarray, s: np.ndarray, frequency_hz: fl
     coefs = np.einsum("kij,kj->ki", np.linalg.pinv(G / (scale[:, :, None] * scale[:, None, :])),
                       h / scale) / scale
     costs = float(Fl @ Fl) - np.einsum("ki,ki->k", coefs, h)
-    k = int(np.argmin(costs))
-    f = grid[k][0]
-    X = np.column_stack([ds, B[k], np.ones_like(tk), tk - tk[0]])
+    best = int(np.argmin(costs))
+    X = np.column_stack([ds, B[best], np.ones_like(tk), tk - tk[0]])
     coef, *_ = np.linalg.lstsq(X, Fl, rcond=None)
     r = Fl - X @ coef
-    best = (float(r @ r), coef, f, X)
-    cost, coef, f, X = best
+    cost = float(r @ r)
     total = float(np.sum((Fl - Fl.mean()) ** 2))
     explained = 1 - cost / total if total > 0 else 0.0
     # both masses negative, each by several of its standard errors (the residual's
@@ -200,5 +196,5 @@ def _reversed_mass(t: np.ndarray, F: np.ndarray, s: np.ndarray, frequency_hz: fl
     se = np.sqrt(np.clip(np.diag(cov)[:2], 0.0, None))
     flipped = all(coef[k] < -_SIGN_SIGMAS * se[k] for k in (0, 1))
     if explained >= SIGN_MIN_EXPLAINED and flipped:
-        return float(coef[0] + coef[1]), float(f), explained
+        return float(coef[0] + coef[1]), float(freqs[best]), explained
     return None

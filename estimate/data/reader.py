@@ -188,20 +188,18 @@ def load_case(path: str | os.PathLike[str], *, strict: bool = False,
             raise CaseError([slow])
     acc = None  # a lateral record's carriage acceleration, for the checks below
     if rig_kind == "lateral" and motion is None and disp is not None:
-        from .signals import displacement_derivatives
-
-        try:
-            acc = displacement_derivatives(time, disp)[2]
-        except Exception:  # noqa: BLE001 - a record the smoother cannot take: not judged
-            acc = None
-    if rig_kind == "lateral" and motion is None and disp is not None:
         from .bad_samples import clipping
+        from .signals import displacement_derivatives
 
         clipped = clipping("displacement", disp, min_runs=3)
         if clipped is not None:
             raise CaseError([f"{data_path.name}: column `displacement`: {clipped.summary()}: "
                              "the carriage motion is unknown where it is clipped; record it "
                              "within the channel's range"])
+        try:
+            acc = displacement_derivatives(time, disp)[2]
+        except Exception:  # noqa: BLE001 - a record the smoother cannot take: not judged
+            acc = None
     if acc is not None and not is_lab_file(data_path):
         for line in _csv_unit_warnings(data_path.name, arrays, rig, prediction, acc):
             warnings.warn(line, ImplausibleUnit, stacklevel=2)

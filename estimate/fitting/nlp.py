@@ -277,6 +277,10 @@ def _solve(problem: FitProblem, transcription: Transcription, hessian: Hessian, 
     opts["ipopt.mumps_pivot_order"] = pivot_order(problem)
     derivatives, f, g_once = nlp.derivative_options(hessian, blocks_ok)
     opts.update(derivatives)
+    recorder = Recorder(nlp.w.numel(), nlp.g.numel(), len(est), scales, 2 * nlp.norm,
+                         progress_printer(problem.names) if progress else None,
+                         stall_stop(problem, int(nlp.r.numel())))
+    opts["iteration_callback"] = recorder
     g = nlp.g
     if "jac_g" in opts:
         # IPOPT gets g and its Jacobian from the per-interval functions (compiled when a
@@ -285,22 +289,13 @@ def _solve(problem: FitProblem, transcription: Transcription, hessian: Hessian, 
         g = nlp.g_fast if g_once is None else g_once
         opts.update({"no_nlp_grad": True, "calc_lam_p": False})
     opts.update(dict(solver_options or {}))
+    solver = ca.nlpsol("fit", "ipopt", {"x": nlp.w, "f": f, "g": g}, opts)
     lbx, ubx = nlp.bounds(est)
     lbg, ubg = nlp.constraint_bounds()
-
-    def run(options: dict):
-        recorder = Recorder(nlp.w.numel(), nlp.g.numel(), len(est), scales, 2 * nlp.norm,
-                            progress_printer(problem.names) if progress else None,
-                            stall_stop(problem, int(nlp.r.numel())))
-        solver = ca.nlpsol("fit", "ipopt", {"x": nlp.w, "f": f, "g": g},
-                           {**options, "iteration_callback": recorder})
-        with surfacing():  # an interrupt inside IPOPT is an interruption, not a non-convergence
-            sol = solver(x0=nlp.w0, lbx=lbx, ubx=ubx, lbg=lbg, ubg=ubg)
-        if progress:
-            print(file=sys.stderr)
-        return solver, sol, recorder
-
-    solver, sol, recorder = run(opts)
+    with surfacing():  # an interrupt inside IPOPT is an interruption, not a non-convergence
+        sol = solver(x0=nlp.w0, lbx=lbx, ubx=ubx, lbg=lbg, ubg=ubg)
+    if progress:
+        print(file=sys.stderr)
     w_opt = np.asarray(sol["x"]).ravel()
     # IPOPT may leave a bounded variable a hair outside its bound (its bound_relax_factor)
     theta = np.clip(w_opt[: len(est)] * scales, [e.lower for e in est], [e.upper for e in est])

@@ -117,10 +117,11 @@ class FitProblem:
         bad = self.left_out[case] if self.left_out else None
         if bad is None:
             return held
+        from ..data.bad_samples import runs
+
         out = held & ~bad
         # a left-out run inside a held-out block (held samples on both sides) is the block's
-        edges = np.diff(np.r_[0, (bad & held).astype(np.int8), 0])
-        for s, e in zip(np.flatnonzero(edges == 1), np.flatnonzero(edges == -1)):
+        for s, e in zip(*runs(bad & held)):
             if s > 0 and e < n and out[s - 1] and out[e]:
                 out[s:e] = True
         return out
