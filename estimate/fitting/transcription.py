@@ -142,11 +142,13 @@ class MultipleShooting(Transcription):
 
     ``samples_per_interval`` sets the nodes: one every that many samples, the states in
     between simulated from the node (:mod:`estimate.fitting.condensed`); ``None`` (default)
-    chooses from the sample rate (:func:`interval_samples`); 1 puts a node at every sample.
+    chooses from the sample rate (:func:`interval_samples`, intervals of ``interval_seconds``,
+    default :data:`INTERVAL_SECONDS`); 1 puts a node at every sample.
     """
 
     substeps: int = 1
     samples_per_interval: int | None = None
+    interval_seconds: float | None = None
 
     def __post_init__(self) -> None:
         k = self.samples_per_interval
@@ -166,7 +168,9 @@ class MultipleShooting(Transcription):
         """Samples per shooting interval on the sample times ``t``: the given
         ``samples_per_interval``, else :func:`interval_samples`."""
         k = self.samples_per_interval
-        return interval_samples(t) if k is None else max(1, min(int(k), (t.size - 1) // 2))
+        if k is None:
+            return interval_samples(t, self.interval_seconds or INTERVAL_SECONDS)
+        return max(1, min(int(k), (t.size - 1) // 2))
 
     def block(self, dm, p, t, U, x_guess, x0, theta=None, compiled=False, coefficients=None):
         n = t.size
@@ -219,14 +223,13 @@ INTERVAL_SECONDS = 0.02
 INTERVAL_SAMPLES_MAX = 16
 
 
-def interval_samples(t: np.ndarray) -> int:
-    """Samples per shooting interval for sample times ``t``: as many as fit in
-    :data:`INTERVAL_SECONDS` (at most :data:`INTERVAL_SAMPLES_MAX`, and at least two
-    intervals per record)."""
+def interval_samples(t: np.ndarray, seconds: float = INTERVAL_SECONDS) -> int:
+    """Samples per shooting interval for sample times ``t``: as many as fit in ``seconds``
+    (at most :data:`INTERVAL_SAMPLES_MAX`, and at least two intervals per record)."""
     if t.size < 5:
         return 1
     dt = float(np.median(np.diff(t)))
-    k = int(np.floor(INTERVAL_SECONDS / dt + 1e-9)) if dt > 0 else 1
+    k = int(np.floor(seconds / dt + 1e-9)) if dt > 0 else 1
     return max(1, min(k, INTERVAL_SAMPLES_MAX, (t.size - 1) // 2))
 
 
