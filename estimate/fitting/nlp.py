@@ -97,7 +97,9 @@ def fit(problem: FitProblem, *, transcription: Transcription = MultipleShooting(
     problem : FitProblem
         Cases, model and the parameters to estimate (:meth:`FitProblem.build`).
     transcription : MultipleShooting or Collocation
-        How the dynamics enter the NLP (default: multiple shooting, one RK4 step per sample).
+        How the dynamics enter the NLP (default: multiple shooting, one RK4 step per sample,
+        a node every 20 ms of samples; a one-mode model is solved with a node every 80 ms
+        first, :data:`COARSE_INTERVAL_SECONDS`).
     hessian : Hessian
         ``Hessian("gauss-newton")`` (default) or ``Hessian("exact")``.
     cost : Cost, {"squared", "abs"} or None
