@@ -53,6 +53,9 @@ class LinearBound:
     upper: float
     #: The bound in words, for the verdict (``"p1.mass + fixed.mass <= liquid mass 2.84 kg"``).
     text: str
+    #: A bound of the integrator's stability (:mod:`estimate.fitting.stability`), kept when
+    #: the fit is retried without the liquid bounds.
+    stability: bool = False
 
     def row(self, names: Sequence[str]) -> np.ndarray:
         """The coefficients as a row over the estimates ``names`` (unscaled)."""

@@ -34,6 +34,7 @@ from .refits import refined
 from .result import FitResult
 from .segment_start import first_part
 from .solution import LOW_R_SQUARED, Solve, fit_result
+from .stability import rotor_bounds
 from .starts import second_start
 from .strategies import Cost, cost_of
 from .transcription import MultipleShooting, Transcription
@@ -176,6 +177,10 @@ def fit(problem: FitProblem, *, transcription: Transcription = MultipleShooting(
             problem = problem.with_initial(start)
     result = _solve(problem, transcription, hessian, cost, kinds, solver_options, progress,
                     compile_, warm_start, t_start)
+    if result.status == "Invalid_Number_Detected" and warm_start is None:
+        problem, result = _within_rk4(problem, result, lambda p: _solve(
+            p, transcription, hessian, cost, kinds, solver_options, progress, compile_, None,
+            t_start))
     other = (second_start(problem, dict(zip(result.names, result.values)))
              if _free_retry and warm_start is None else None)
     if other is not None:
@@ -194,6 +199,29 @@ def fit(problem: FitProblem, *, transcription: Transcription = MultipleShooting(
                    balance=balance, free_retry=_free_retry,
                    unbounded_retry=unbounded_retry, hold_undetermined=hold_undetermined,
                    t_start=t_start)
+
+
+def _within_rk4(problem: FitProblem, result: FitResult, solve
+                ) -> tuple[FitProblem, FitResult]:
+    """``problem`` and ``result`` (a solve whose simulation overflowed), or the solve of
+    ``problem`` from the same start with its rotors' spin-up bounded to what the RK4 steps
+    integrate stably (:mod:`estimate.fitting.stability`) when that converges, with a note.
+    The bound is added only then: present from the start it changed IPOPT's path on
+    spinning-rig records that converge without it (one then ran 300 iterations)."""
+    bounds = rotor_bounds([e.case for e in problem.experiments], problem.model,
+                          problem.names)
+    if not bounds or any(b.stability for b in problem.linear_bounds):
+        return problem, result
+    bounded = replace(problem, linear_bounds=problem.linear_bounds + bounds)
+    second = solve(bounded)
+    iterations = result.iterations + second.iterations
+    if not second.converged:
+        return problem, replace(result, iterations=iterations)
+    note = (f"the fit's simulation overflowed ({result.status} after {result.iterations} "
+            f"iterations): solved again from the same start with "
+            + "; ".join(b.text for b in bounds))
+    bounded = replace(bounded, notes=bounded.notes + (note,))
+    return bounded, replace(second, problem=bounded, iterations=iterations)
 
 
 def _from_first_part(problem: FitProblem, result: FitResult, short: FitProblem, what: str,

@@ -58,8 +58,9 @@ warm_start, balance
     """
     from .nlp import IPOPT_DEFAULTS, fit
 
-    if result.converged and result.active_bounds and problem.linear_bounds and free_retry \
-            and unbounded_retry:
+    liquid_active = any(b.text in result.active_bounds for b in problem.linear_bounds
+                        if not b.stability)
+    if result.converged and liquid_active and free_retry and unbounded_retry:
         # the free fit gets a few times the bounded one's iterations: one that wants more
         # mass than the liquid walks far (a diagnosis baseline lacking two effects: 300
         # iterations, 24 s, to be discarded)
@@ -137,7 +138,8 @@ def _without_linear_bounds(problem: FitProblem, bounded: FitResult, **options
     0.026 N. A minimum inside the bounds is a minimum of the bounded problem too."""
     from .nlp import fit
 
-    free = fit(replace(problem, linear_bounds=()), **options)
+    kept = tuple(b for b in problem.linear_bounds if b.stability)  # the RK4's stay
+    free = fit(replace(problem, linear_bounds=kept), **options)
     inside = all(b.slack(problem.names, free.values) >= -BUDGET_RTOL * abs(b.upper)
                  for b in problem.linear_bounds)
     if not (free.converged and inside and free.rms_residual < bounded.rms_residual):

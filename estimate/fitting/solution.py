@@ -125,9 +125,14 @@ def fit_result(problem: FitProblem, solve: Solve) -> FitResult:
         unc = _held_on(unc, np.array([b.row(problem.names) for b in active]))
     warnings = list(unc.warnings)
     for b in active:
-        warnings.append(f"the estimates end on the bound {b.text}: the data ask for more mass "
-                        "than the liquid holds (check the dry mass, the fill and the density, "
-                        "or a mode the model lacks); held there in the covariance")
+        if b.stability:
+            warnings.append(f"the estimates end on the bound {b.text}: the record does not "
+                            "resolve a faster spin-up (the rotor acts as a damper there); "
+                            "held there in the covariance")
+        else:
+            warnings.append(f"the estimates end on the bound {b.text}: the data ask for more "
+                            "mass than the liquid holds (check the dry mass, the fill and the "
+                            "density, or a mode the model lacks); held there in the covariance")
     status = stats.get("return_status", "unknown")
     converged = bool(stats.get("success", False))
     if not converged:

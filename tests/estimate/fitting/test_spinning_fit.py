@@ -42,12 +42,6 @@ def short_spinning_case(tmp_path_factory):
 
 
 @pytest.mark.slow  # 80 s with its record; notebook 04 fits fixed,p1,r1 on six channels by default
-@pytest.mark.xfail(reason="since 37bd075 (IPOPT's bound multipliers from 1e-5) the fit from the "
-                   "first stage overflows at its third iteration and its first-third refit does "
-                   "not converge either (Invalid_Number_Detected, reported, no longer a crash); "
-                   "solved again with multipliers 1 it converges in 27 iterations, but that "
-                   "retry made the 60 s record's fit (test_diverged) run over 10 minutes",
-                   strict=False)
 def test_six_channel_fit_recovers_rotor_and_pendulum(spinning_case):
     case = spinning_case
     model = model_from_spec("fixed,p1:nospring,r1", case)
