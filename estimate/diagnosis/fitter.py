@@ -17,6 +17,7 @@ from ..fitting.measurement import MeasurementModel
 from ..fitting.nlp import fit
 from ..fitting.problem import FitProblem
 from ..fitting.result import FitResult
+from ..fitting.stability import RK4_MARGIN
 from .scoring import far_from_noise
 
 __all__ = ["Budget", "FitRecord", "Fitter", "BUDGETS", "SECONDS_PER_SAMPLE",
@@ -73,10 +74,10 @@ SECONDS_PER_SPINNING_SAMPLE = 0.04
 #: overflowed and MUMPS reallocated memory for minutes).
 MIN_MASS_SHARE = 0.1
 #: ... and its damper below the value where one RK4 step of the sample interval ``h`` on
-#: the lightest, shortest pendulum the bounds allow has ``h c / (m L^2)`` = this (RK4 is
+#: the lightest, shortest pendulum the bounds allow has ``h c / (m L^2)`` =
+#: :data:`~estimate.fitting.stability.RK4_MARGIN` (the rotor's bound uses the same; RK4 is
 #: stable below ~2.8 on a real eigenvalue). On the 8-inch sphere at 100 Hz that is a
 #: damping ratio of about 0.5 at the predicted mass of the first mode.
-RK4_MARGIN = 2.0
 #: IPOPT statuses that mean a budget ended the fit.
 _ENDED_BY = {"Maximum_Iterations_Exceeded": "iterations", "Maximum_CpuTime_Exceeded": "time"}
 
